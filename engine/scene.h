@@ -1,0 +1,155 @@
+// Scene files (INTERFACE.md "Scene files"; docs/scene-format.md documents every
+// key). A SceneDescription is the validated, SI-unit content of one file: the
+// demos, the tests, the benchmarks and `odemag` all read scenes through it.
+#pragma once
+
+#include <array>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "magnetics/material.h"
+#include "magnetics/relax.h"
+#include "magnetics/shape.h"
+#include "magnetics/vec3.h"
+
+namespace odemag {
+
+// A bad scene: the file, the JSON key path (e.g. "bodies[2].shape.sphere")
+// and what is wrong. what() reads "FILE: KEY: message".
+class SceneError : public std::runtime_error {
+ public:
+  SceneError(std::string file, std::string key, std::string message);
+  const std::string& file() const { return file_; }
+  const std::string& key() const { return key_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  std::string file_, key_, message_;
+};
+
+struct Quaternion {
+  double w = 1.0, x = 0.0, y = 0.0, z = 0.0;
+};
+
+struct BodyDescription {
+  std::string name;
+  Shape shape;
+  std::string material;             // key into SceneDescription::materials
+  Vec3 position;                    // centre of mass, world, m
+  Quaternion orientation;           // body -> world
+  Vec3 velocity;                    // m/s
+  Vec3 angular_velocity;            // rad/s
+  bool fixed = false;               // not moved by dynamics (may be moved by keyframes)
+  double density = 1000.0;          // kg/m^3
+  std::optional<double> cell_size;  // overrides the scene's cell_size
+  bool present = true;              // false: added later by an "add" event
+  std::optional<std::array<double, 3>> color;  // RGB 0..1, overrides the material colour
+};
+
+struct SolverSettings {
+  RelaxOptions relax;          // scheme, tolerance, max_iterations, mutual_induction, ...
+  std::string backend = "auto";  // "cpu", "cuda", "auto"
+  int threads = 0;             // 0: all cores
+};
+
+struct ContactSettings {
+  double friction = 0.5;      // Coulomb mu
+  double restitution = 0.1;   // bounce
+  double softness = 1e-5;     // ODE CFM
+  double erp = 0.2;           // ODE error reduction parameter
+};
+
+struct SimulationSettings {
+  double time_step = 0.004;   // rigid step, s
+  double duration = 2.0;      // s
+  double frame_rate = 30.0;   // frames written per simulated second
+  int solver_iterations = 30; // dWorldQuickStep iterations
+  bool ground = true;         // a ground plane z = ground_height
+  double ground_height = 0.0;
+  ContactSettings contact;
+  double linear_damping = 0.0;
+  double angular_damping = 0.0;
+};
+
+// A keyframe of a scripted (kinematic) body.
+struct Keyframe {
+  double time = 0.0;
+  Vec3 position;
+  Quaternion orientation;
+};
+
+// Time-line events (docs/scene-format.md "timeline").
+struct TimelineEvent {
+  enum class Kind {
+    add_body,             // body appears at `time`
+    remove_body,          // body stops existing at `time`
+    scale_magnetization,  // permanent magnet's M_r scaled from its value at `time` to `value` at `end_time`
+    mutual_induction,     // switch mutual induction to `enabled`
+    external_field,       // H_E ramps to `field` between `time` and `end_time`
+    keyframes,            // body follows `keys` (linear position, slerp orientation)
+  };
+  Kind kind = Kind::remove_body;
+  double time = 0.0;
+  double end_time = 0.0;      // == time for instantaneous events
+  std::string body;
+  double value = 1.0;
+  bool enabled = true;
+  Vec3 field;
+  std::vector<Keyframe> keys;
+};
+
+struct CameraSettings {
+  Vec3 position{0.3, -0.3, 0.2};
+  Vec3 target{0.0, 0.0, 0.05};
+  Vec3 up{0.0, 0.0, 1.0};
+  double fov_degrees = 40.0;
+  int width = 640;
+  int height = 480;
+};
+
+struct RenderSettings {
+  bool field_lines = false;   // grey field lines traced from the solved field
+  int field_line_count = 48;
+  bool force_colors = false;  // bodies coloured by force magnitude (violet..red)
+};
+
+// A number the scene reports in summary.json: how many bodies whose names start
+// with `prefix` have their centre above `height` (m) at time `time`
+// (negative: the end of the run).
+struct OutcomeDescription {
+  std::string name;
+  std::string prefix;
+  double height = 0.0;
+  double time = -1.0;
+};
+
+struct SceneDescription {
+  std::string file;            // path the scene was read from (for messages)
+  std::string title;
+  Vec3 gravity{0.0, 0.0, -9.81};
+  Vec3 external_field;         // uniform H_E, A/m
+  double cell_size = 0.0;      // lattice spacing h, m; 0: single cells
+  uint64_t seed = 1;           // initial moment directions and noise
+  std::map<std::string, Material> materials;
+  std::map<std::string, std::array<double, 3>> material_colors;  // optional "color" per material
+  std::vector<BodyDescription> bodies;
+  SolverSettings solver;
+  SimulationSettings simulation;
+  std::vector<TimelineEvent> timeline;
+  CameraSettings camera;
+  RenderSettings render;
+  std::vector<OutcomeDescription> outcomes;
+
+  int find_body(const std::string& name) const;  // -1 when absent
+};
+
+// Reads and validates a scene file. Throws SceneError (bad content, unknown
+// key, wrong type, NaN, negative size, missing key, unknown material, ...).
+SceneDescription load_scene(const std::string& path);
+// Same, from JSON text; `file` is used in messages.
+SceneDescription parse_scene(const std::string& json_text, const std::string& file);
+
+}  // namespace odemag

@@ -1,0 +1,61 @@
+// The solver interface: the parts of a magnetic step whose cost grows with the
+// number of cells (fields, local relaxation, forces). The CPU backend
+// (magnetics/cpu_backend.cpp) and the CUDA backend (gpu/) implement it; the
+// relaxation driver (magnetics/relax.h) runs on top of either.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "magnetics/llg.h"
+#include "magnetics/model.h"
+#include "magnetics/state.h"
+
+namespace odemag {
+
+struct LocalStats {
+  long llg_steps = 0;
+  long newton_steps = 0;
+  double max_residual = 0.0;  // largest relative torque of a soft cell
+};
+
+// Per-cell vectors below have model.cell_count() entries, indexed by cell;
+// entries of cells a call does not concern are left untouched.
+class MagneticBackend {
+ public:
+  virtual ~MagneticBackend() = default;
+  virtual std::string name() const = 0;
+
+  // New rigid step: cell positions, active flags or fixed magnetizations
+  // changed (call after place_cells).
+  virtual void begin_step(const MagneticModel& model, const MagneticState& state) = 0;
+
+  // H_E plus the field of every fixed permanent cell, at each active
+  // responsive cell. Constant during a relaxation.
+  virtual void fixed_field(const MagneticModel& model, const MagneticState& state,
+                           std::vector<Vec3>& H) = 0;
+
+  // Field of the responsive cells (their state.magnetization) at each active
+  // responsive cell: the intra-body part from the cached tensors, the
+  // inter-body part from the dipole kernel. sources_soft: include soft cells as sources.
+  virtual void responsive_field(const MagneticModel& model, const MagneticState& state,
+                                std::vector<Vec3>& H) = 0;
+
+  // Relaxes every active responsive cell under its applied field H_A and
+  // updates moments and state.magnetization.
+  virtual LocalStats relax_cells(const MagneticModel& model, MagneticState& state,
+                                 const std::vector<Vec3>& H_A, const LocalRelaxOptions& options) = 0;
+
+  // state.force and state.torque of every body from the magnetizations.
+  virtual void forces(const MagneticModel& model, MagneticState& state) = 0;
+
+  // H (A/m) at world points from H_E and every active cell.
+  virtual void field_at_points(const MagneticModel& model, const MagneticState& state,
+                               const std::vector<Vec3>& points, std::vector<Vec3>& H) = 0;
+};
+
+// threads <= 0: all cores (OpenMP default).
+std::unique_ptr<MagneticBackend> make_cpu_backend(int threads = 0);
+
+}  // namespace odemag

@@ -1,0 +1,221 @@
+// CPU backend: OpenMP over target cells, one thread per target, sums in a fixed
+// order, so results do not depend on the thread count (determinism).
+#include <omp.h>
+
+#include <algorithm>
+
+#include "magnetics/backend.h"
+#include "magnetics/kernels.h"
+
+namespace odemag {
+
+namespace {
+
+// Cells as structure of arrays, for the pair loops.
+struct CellArrays {
+  std::vector<double> x, y, z, radius, mx, my, mz;  // position, radius, moment mu = M V
+  std::vector<int> cell, body;
+  void clear() {
+    for (auto* v : {&x, &y, &z, &radius, &mx, &my, &mz}) v->clear();
+    cell.clear();
+    body.clear();
+  }
+  int size() const { return static_cast<int>(x.size()); }
+  void push(const MagneticModel& model, const MagneticState& state, int c) {
+    const Vec3& p = state.cell_position[c];
+    x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
+    radius.push_back(model.body(model.cell_body(c)).cells.cell_radius);
+    mx.push_back(0), my.push_back(0), mz.push_back(0);
+    cell.push_back(c);
+    body.push_back(model.cell_body(c));
+  }
+  void load_moments(const MagneticModel& model, const MagneticState& state) {
+    for (int i = 0; i < size(); ++i) {
+      const Vec3 mu = model.body(body[i]).cells.cell_volume * state.magnetization[cell[i]];
+      mx[i] = mu.x, my[i] = mu.y, mz[i] = mu.z;
+    }
+  }
+};
+
+// Field at (tx, ty, tz) of sources [j0, j1) through the kernel with contact
+// distance s = target_radius + source radius (overlap_radius < 0: exact dipole).
+inline Vec3 sum_field(const CellArrays& s, int j0, int j1, double tx, double ty, double tz,
+                      double target_radius, bool regularised) {
+  double hx = 0, hy = 0, hz = 0;
+  const double* __restrict x = s.x.data();
+  const double* __restrict y = s.y.data();
+  const double* __restrict z = s.z.data();
+  const double* __restrict r = s.radius.data();
+  const double* __restrict mx = s.mx.data();
+  const double* __restrict my = s.my.data();
+  const double* __restrict mz = s.mz.data();
+#pragma omp simd reduction(+ : hx, hy, hz)
+  for (int j = j0; j < j1; ++j) {
+    const double dx = tx - x[j], dy = ty - y[j], dz = tz - z[j];
+    const double contact = regularised ? target_radius + r[j] : 0.0;
+    const DipoleCoefficients c = dipole_coefficients(dx * dx + dy * dy + dz * dz, contact * contact);
+    const double rm = c.B * (dx * mx[j] + dy * my[j] + dz * mz[j]);
+    hx += c.A * mx[j] + rm * dx;
+    hy += c.A * my[j] + rm * dy;
+    hz += c.A * mz[j] + rm * dz;
+  }
+  return {hx, hy, hz};
+}
+
+class CpuBackend final : public MagneticBackend {
+ public:
+  explicit CpuBackend(int threads) : threads_(threads > 0 ? threads : omp_get_max_threads()) {}
+
+  std::string name() const override { return "cpu"; }
+
+  void begin_step(const MagneticModel& model, const MagneticState& state) override {
+    fixed_.clear();
+    resp_.clear();
+    all_.clear();
+    resp_range_.clear();
+    for (int b = 0; b < model.body_count(); ++b) {
+      const MagneticBody& body = model.body(b);
+      if (body.inert() || !state.active[b]) continue;
+      const int begin = resp_.size();
+      for (int i = 0; i < body.cell_count(); ++i) {
+        const int c = body.first_cell + i;
+        all_.push(model, state, c);
+        if (body.responsive()) {
+          resp_.push(model, state, c);
+        } else {
+          fixed_.push(model, state, c);
+        }
+      }
+      for (int i = begin; i < resp_.size(); ++i) resp_range_.push_back({begin, resp_.size()});
+    }
+    fixed_.load_moments(model, state);
+  }
+
+  void fixed_field(const MagneticModel&, const MagneticState& state, std::vector<Vec3>& H) override {
+    const int n = resp_.size();
+#pragma omp parallel for schedule(static) num_threads(threads_)
+    for (int i = 0; i < n; ++i)
+      H[resp_.cell[i]] = state.external_field +
+                         sum_field(fixed_, 0, fixed_.size(), resp_.x[i], resp_.y[i], resp_.z[i],
+                                   resp_.radius[i], true);
+  }
+
+  void responsive_field(const MagneticModel& model, const MagneticState& state,
+                        std::vector<Vec3>& H) override {
+    resp_.load_moments(model, state);
+    const int n = resp_.size();
+    // Body-frame moments for the intra-body sums.
+    body_moment_.resize(n);
+    for (int i = 0; i < n; ++i)
+      body_moment_[i] = state.pose[resp_.body[i]].rotation.transpose_times(
+          {resp_.mx[i], resp_.my[i], resp_.mz[i]});
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads_)
+    for (int i = 0; i < n; ++i) {
+      const auto [begin, end] = resp_range_[i];
+      // Inter-body: every responsive cell of another body.
+      Vec3 h = sum_field(resp_, 0, begin, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i], true) +
+               sum_field(resp_, end, n, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i], true);
+      // Intra-body: cached tensors of the body, in the body frame.
+      const MagneticBody& body = model.body(resp_.body[i]);
+      if (end - begin > 1) {
+        const auto& li = body.cells.lattice_index[resp_.cell[i] - body.first_cell];
+        Vec3 hb;
+        for (int j = begin; j < end; ++j) {
+          if (j == i) continue;
+          const auto& lj = body.cells.lattice_index[resp_.cell[j] - body.first_cell];
+          hb += symmetric_times(&body.offset_tensors[6u * body.offset_index(li, lj)], body_moment_[j]);
+        }
+        h += state.pose[resp_.body[i]].rotation * hb;
+      }
+      H[resp_.cell[i]] = h;
+    }
+  }
+
+  LocalStats relax_cells(const MagneticModel& model, MagneticState& state,
+                         const std::vector<Vec3>& H_A, const LocalRelaxOptions& options) override {
+    const int n = resp_.size();
+    long llg = 0, newton = 0;
+    double worst = 0.0;
+#pragma omp parallel for schedule(dynamic, 8) num_threads(threads_) reduction(+ : llg, newton) \
+    reduction(max : worst)
+    for (int i = 0; i < n; ++i) {
+      const int c = resp_.cell[i], b = resp_.body[i];
+      const MagneticBody& body = model.body(b);
+      const Mat3& R = state.pose[b].rotation;
+      if (body.kind == CellKind::recoil_permanent) {
+        state.magnetization[c] = recoil_magnetization(
+            R * (state.magnetization_scale[b] * body.remanence), body.recoil, H_A[c]);
+        continue;
+      }
+      const int off = model.moment_offset(c);
+      bool history = state.llg_history[c] != 0;
+      const LocalRelaxResult r = relax_soft_cell(
+          body.soft, R.transpose_times(H_A[c]), &state.moments[off], &state.moment_hc_prev[off],
+          history, state.noise_counter[c], hash_key(state.seed, 0x4e4f495345ULL, c, 0), options);
+      state.llg_history[c] = history ? 1 : 0;
+      state.magnetization[c] = R * (body.soft.Ms * mean_moment(&state.moments[off], body.soft.n));
+      llg += r.llg_steps;
+      newton += r.newton_steps;
+      worst = std::max(worst, r.residual);
+    }
+    return {llg, newton, worst};
+  }
+
+  void forces(const MagneticModel& model, MagneticState& state) override {
+    all_.load_moments(model, state);
+    const int n = all_.size();
+    cell_force_.assign(n, {});
+    cell_field_.assign(n, {});
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads_)
+    for (int i = 0; i < n; ++i) {
+      const Vec3 xi{all_.x[i], all_.y[i], all_.z[i]}, mi{all_.mx[i], all_.my[i], all_.mz[i]};
+      Vec3 f, h;
+      for (int j = 0; j < n; ++j) {
+        if (all_.body[j] == all_.body[i]) continue;  // pairs inside a body cancel
+        const Vec3 r = xi - Vec3{all_.x[j], all_.y[j], all_.z[j]};
+        const Vec3 mj{all_.mx[j], all_.my[j], all_.mz[j]};
+        const double s = all_.radius[i] + all_.radius[j];
+        f += dipole_force(r, mj, mi, s * s);
+        h += dipole_field(r, mj, s * s);
+      }
+      cell_force_[i] = f;
+      cell_field_[i] = h;
+    }
+    std::fill(state.force.begin(), state.force.end(), Vec3{});
+    std::fill(state.torque.begin(), state.torque.end(), Vec3{});
+    for (int i = 0; i < n; ++i) {
+      const int b = all_.body[i];
+      const Vec3 xi{all_.x[i], all_.y[i], all_.z[i]}, mi{all_.mx[i], all_.my[i], all_.mz[i]};
+      state.force[b] += cell_force_[i];
+      // tau = (x - c) x F + mu0 mu x (H_other + H_E)  (MODEL.md "Forces and torques").
+      state.torque[b] += cross(xi - state.pose[b].position, cell_force_[i]) +
+                         kMu0 * cross(mi, cell_field_[i] + state.external_field);
+    }
+  }
+
+  void field_at_points(const MagneticModel& model, const MagneticState& state,
+                       const std::vector<Vec3>& points, std::vector<Vec3>& H) override {
+    all_.load_moments(model, state);
+    const int n = static_cast<int>(points.size());
+    H.resize(n);
+#pragma omp parallel for schedule(static) num_threads(threads_)
+    for (int p = 0; p < n; ++p)
+      // A point is a target of radius 0: the kernel is bounded inside each cell's sphere.
+      H[p] = state.external_field +
+             sum_field(all_, 0, all_.size(), points[p].x, points[p].y, points[p].z, 0.0, true);
+  }
+
+ private:
+  int threads_;
+  CellArrays fixed_, resp_, all_;
+  std::vector<std::pair<int, int>> resp_range_;  // per responsive cell: its body's range in resp_
+  std::vector<Vec3> body_moment_, cell_force_, cell_field_;
+};
+
+}  // namespace
+
+std::unique_ptr<MagneticBackend> make_cpu_backend(int threads) {
+  return std::make_unique<CpuBackend>(threads);
+}
+
+}  // namespace odemag

@@ -1,0 +1,82 @@
+// The dipole interaction kernel: one place for the field, force and torque
+// between two cells (MODEL.md "Effective field", "Forces and torques",
+// "Hard cases"; docs/model.md derives the overlap form).
+//
+// The field of a moment mu at offset r is H = T(r) mu with T the Hessian of
+// g(r) = 1 / (4 pi |r|):  T = A(r) I + B(r) r r^T,
+//   A = -1/(4 pi r^3),  B = 3/(4 pi r^5)          (exact point dipole, = -D(r)).
+// The force on moment b from moment a (r = x_b - x_a) is
+//   F_b = mu0 [ B ((r.mu_a) mu_b + (r.mu_b) mu_a + (mu_a.mu_b) r) + C (r.mu_a)(r.mu_b) r ],
+// with C = B'(r)/r = -15/(4 pi r^7); A'(r)/r = B for every radial g.
+//
+// Overlap: below the contact distance s (sum of the two cell radii) g is
+// replaced by the even polynomial c0 + c1 r^2 + c2 r^4 + c3 r^6 that matches
+// g, g', g'', g''' at s. Then A, B and C are polynomials: fields and forces
+// are bounded, continuous at s, exactly dipolar for r >= s, and still the
+// derivatives of one pair energy (so F = -grad U holds everywhere).
+#pragma once
+
+#include "magnetics/constants.h"
+#include "magnetics/hd.h"
+#include "magnetics/vec3.h"
+
+namespace odemag {
+
+struct DipoleCoefficients {
+  double A;  // isotropic part of T
+  double B;  // r r^T part of T
+  double C;  // B'(r) / r, for the force
+};
+
+// s2 = s^2, the squared contact distance; s2 = 0 gives the exact point dipole.
+ODEMAG_HD DipoleCoefficients dipole_coefficients(double r2, double s2) {
+  const double k = 1.0 / (4.0 * kPi);
+  if (r2 >= s2) {
+    const double inv_r2 = 1.0 / r2;
+    const double inv_r3 = inv_r2 * sqrt(inv_r2);
+    const double inv_r5 = inv_r3 * inv_r2;
+    return {-k * inv_r3, 3.0 * k * inv_r5, -15.0 * k * inv_r5 * inv_r2};
+  }
+  const double inv_s2 = 1.0 / s2;
+  const double inv_s3 = inv_s2 * sqrt(inv_s2);
+  const double inv_s5 = inv_s3 * inv_s2;
+  const double q = r2 * inv_s2;
+  return {k * inv_s3 * (-35.0 / 8.0 + q * (21.0 / 4.0 - q * (15.0 / 8.0))),
+          k * inv_s5 * (21.0 / 2.0 - q * (15.0 / 2.0)), -15.0 * k * inv_s5 * inv_s2};
+}
+
+// Field H (A/m) at offset r from a moment mu (A m^2): T(r) mu.
+ODEMAG_HD Vec3 dipole_field(const Vec3& r, const Vec3& mu, double s2) {
+  const DipoleCoefficients c = dipole_coefficients(dot(r, r), s2);
+  return c.A * mu + (c.B * dot(r, mu)) * r;
+}
+
+// Force (N) on moment mu_b from moment mu_a, r = x_b - x_a.
+ODEMAG_HD Vec3 dipole_force(const Vec3& r, const Vec3& mu_a, const Vec3& mu_b, double s2) {
+  const DipoleCoefficients c = dipole_coefficients(dot(r, r), s2);
+  const double ra = dot(r, mu_a), rb = dot(r, mu_b);
+  return kMu0 * (c.B * (ra * mu_b + rb * mu_a + dot(mu_a, mu_b) * r) + (c.C * ra * rb) * r);
+}
+
+// Interaction energy (J) of the pair: U = -mu0 mu_b . T(r) mu_a.
+ODEMAG_HD double dipole_energy(const Vec3& r, const Vec3& mu_a, const Vec3& mu_b, double s2) {
+  return -kMu0 * dot(mu_b, dipole_field(r, mu_a, s2));
+}
+
+// The six independent components (xx, xy, xz, yy, yz, zz) of T(r).
+ODEMAG_HD void dipole_tensor(const Vec3& r, double s2, double* t) {
+  const DipoleCoefficients c = dipole_coefficients(dot(r, r), s2);
+  t[0] = c.A + c.B * r.x * r.x;
+  t[1] = c.B * r.x * r.y;
+  t[2] = c.B * r.x * r.z;
+  t[3] = c.A + c.B * r.y * r.y;
+  t[4] = c.B * r.y * r.z;
+  t[5] = c.A + c.B * r.z * r.z;
+}
+
+ODEMAG_HD Vec3 symmetric_times(const double* t, const Vec3& v) {
+  return {t[0] * v.x + t[1] * v.y + t[2] * v.z, t[1] * v.x + t[3] * v.y + t[4] * v.z,
+          t[2] * v.x + t[4] * v.y + t[5] * v.z};
+}
+
+}  // namespace odemag

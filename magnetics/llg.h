@@ -1,0 +1,307 @@
+// Per-cell magnetization dynamics (MODEL.md "Effective field on moment k",
+// "Landau-Lifshitz-Gilbert, integrated"; paper Sections 3.4, 4.4, 4.6).
+//
+// A soft cell holds n unit moments m_k (stored in the body frame); its
+// magnetization is M = Ms * mean(m_k). Under a frozen applied field H_A (the
+// external field plus the field of every other cell) each moment feels
+//   H_eff,k = H_A + H_endo + H_K,k + H_noise,k.
+// Everything here is local to one cell and written once for host and device.
+#pragma once
+
+#include <cstdint>
+
+#include "magnetics/constants.h"
+#include "magnetics/hd.h"
+#include "magnetics/rng.h"
+#include "magnetics/small_eigen.h"
+#include "magnetics/vec3.h"
+
+namespace odemag {
+
+inline constexpr int kMaxMomentsPerCell = 8;
+
+struct SoftCellParams {
+  double Ms = 0.0;       // saturation magnetization, A/m
+  double gamma_D = 0.0;  // demagnetising factor of the cell, 1/3 + 1/chi
+  double H_K = 0.0;      // anisotropy field, A/m (the paper's 2 K_u)
+  Vec3 easy_axis;        // unit vector in the moments' frame
+  double alpha = 1.0;    // Gilbert damping
+  int n = 2;             // moments per cell
+};
+
+struct LocalRelaxOptions {
+  // Pseudo time step dt = tau (1 + alpha^2) / (gamma0 S), S = gamma_D Ms + H_K + |H_A|.
+  // docs/model.md: the free energy falls monotonically for tau <= 0.6 and
+  // rises at 0.8; tau = 2 diverges. 0.5 keeps a margin.
+  double time_step_factor = 0.5;
+  int max_llg_steps = 60;          // LLG steps per inner relaxation
+  double llg_switch = 1e-2;        // relative torque below which Newton takes over
+  bool newton = true;              // Newton polish after the LLG steps
+  int max_newton_steps = 40;
+  double tolerance = 1e-12;        // relative torque at which a cell is relaxed
+  double noise_ratio = 1e-6;       // |H_noise| / |H_eff| (paper Sec. 4.6)
+  bool single_step = false;        // exactly one LLG step (paper Algorithm 1)
+};
+
+struct LocalRelaxResult {
+  int llg_steps = 0;
+  int newton_steps = 0;
+  double residual = 0.0;  // relative torque after relaxation
+};
+
+// ---- field terms --------------------------------------------------------------
+
+ODEMAG_HD Vec3 mean_moment(const Vec3* m, int n) {
+  Vec3 s;
+  for (int k = 0; k < n; ++k) s += m[k];
+  return (1.0 / n) * s;
+}
+
+// H_endo = -gamma_D M, M = Ms * mean(m)  (paper Eq. 16, 23).
+ODEMAG_HD Vec3 endo_field(const SoftCellParams& p, const Vec3& mean_m) {
+  return (-p.gamma_D * p.Ms) * mean_m;
+}
+
+// H_K,k = -H_K (m_k - (m_k . e) e): zero on the easy axis (paper Eq. 24).
+ODEMAG_HD Vec3 anisotropy_field(const SoftCellParams& p, const Vec3& m) {
+  if (p.H_K == 0.0) return {};
+  return (-p.H_K) * (m - dot(m, p.easy_axis) * p.easy_axis);
+}
+
+// H_noise,k: ratio * |H_eff| in a direction drawn from key (paper Sec. 4.6).
+ODEMAG_HD Vec3 noise_field(double ratio, const Vec3& heff, uint64_t key) {
+  if (ratio == 0.0) return {};
+  return (ratio * norm(heff)) * random_unit_vector(key);
+}
+
+// H_eff,k without the noise term.
+ODEMAG_HD Vec3 effective_field(const SoftCellParams& p, const Vec3& H_A, const Vec3& mean_m,
+                               const Vec3& m) {
+  return H_A + endo_field(p, mean_m) + anisotropy_field(p, m);
+}
+
+// ---- LLG integration ----------------------------------------------------------
+
+// Hc = H_eff + alpha m x H_eff  (paper Eq. 9).
+ODEMAG_HD Vec3 gilbert_field(const Vec3& m, const Vec3& heff, double alpha) {
+  return heff + alpha * cross(m, heff);
+}
+
+// Closed form of the implicit midpoint equation m' - m = a x (m' + m)
+// (paper Eq. 12 with a = gamma0 dt / (2 (1 + alpha^2)) Hc): a Cayley rotation,
+// so |m'| = |m| exactly.
+ODEMAG_HD Vec3 cayley_step(const Vec3& m, const Vec3& a) {
+  const Vec3 am = cross(a, m);
+  return m + (2.0 / (1.0 + squared_norm(a))) * (am + cross(a, am));
+}
+
+// Field scale S bounding the stiffness of the cell's dynamics; sets dt.
+ODEMAG_HD double llg_field_scale(const SoftCellParams& p, const Vec3& H_A) {
+  return p.gamma_D * p.Ms + p.H_K + norm(H_A);
+}
+
+// Coefficient c with a = c Hc:  c = gamma0 dt / (2 (1 + alpha^2)) = tau / (2 S).
+ODEMAG_HD double cayley_coefficient(const SoftCellParams& p, const Vec3& H_A, double tau) {
+  return tau / (2.0 * llg_field_scale(p, H_A));
+}
+
+// One LLG step of every moment of the cell under the frozen field H_A:
+// implicit midpoint with Hc extrapolated to the half step,
+// Hc_half = 3/2 Hc^i - 1/2 Hc^(i-1) (paper Eq. 13); without history the step
+// is second-order Runge-Kutta (midpoint). hc_prev holds Hc^(i-1).
+ODEMAG_HD void llg_step(const SoftCellParams& p, const Vec3& H_A, Vec3* m, Vec3* hc_prev,
+                        bool& has_history, double c, double noise_ratio, uint64_t noise_key) {
+  const int n = p.n;
+  Vec3 hc[kMaxMomentsPerCell], noise[kMaxMomentsPerCell];
+  const Vec3 mean_m = mean_moment(m, n);
+  for (int k = 0; k < n; ++k) {
+    const Vec3 heff = effective_field(p, H_A, mean_m, m[k]);
+    noise[k] = noise_field(noise_ratio, heff, mix64(noise_key + static_cast<uint64_t>(k)));
+    hc[k] = gilbert_field(m[k], heff + noise[k], p.alpha);
+  }
+  if (!has_history) {
+    Vec3 mh[kMaxMomentsPerCell];
+    for (int k = 0; k < n; ++k) mh[k] = cayley_step(m[k], (0.5 * c) * hc[k]);
+    const Vec3 mean_h = mean_moment(mh, n);
+    for (int k = 0; k < n; ++k) {
+      const Vec3 heff_h = effective_field(p, H_A, mean_h, mh[k]) + noise[k];
+      m[k] = cayley_step(m[k], c * gilbert_field(mh[k], heff_h, p.alpha));
+    }
+  } else {
+    for (int k = 0; k < n; ++k) m[k] = cayley_step(m[k], c * (1.5 * hc[k] - 0.5 * hc_prev[k]));
+  }
+  for (int k = 0; k < n; ++k) hc_prev[k] = hc[k];
+  has_history = true;
+}
+
+// ---- energy and convergence ---------------------------------------------------
+
+// Free energy density of the cell divided by mu0 Ms (A/m):
+//   G / (mu0 Ms) = -H_A . mean(m) + gamma_D Ms |mean(m)|^2 / 2
+//                  + H_K / (2n) sum_k |m_k - (m_k . e) e|^2.
+// Its gradient with respect to m_k is -H_eff,k / n (paper App. B, Eq. 32).
+ODEMAG_HD double cell_free_energy(const SoftCellParams& p, const Vec3& H_A, const Vec3* m) {
+  const Vec3 mean_m = mean_moment(m, p.n);
+  double e = -dot(H_A, mean_m) + 0.5 * p.gamma_D * p.Ms * squared_norm(mean_m);
+  if (p.H_K != 0.0) {
+    double s = 0.0;
+    for (int k = 0; k < p.n; ++k) {
+      const double c = dot(m[k], p.easy_axis);
+      s += 1.0 - c * c;
+    }
+    e += 0.5 * p.H_K * s / p.n;
+  }
+  return e;
+}
+
+// Field scale for the convergence measure: the sizes of the terms of H_eff
+// that do not vanish at equilibrium, with a floor so 0/0 cannot occur.
+ODEMAG_HD double torque_scale(const SoftCellParams& p, const Vec3& H_A, const Vec3& mean_m) {
+  return norm(H_A) + p.gamma_D * p.Ms * norm(mean_m) + 1e-9 * (p.gamma_D * p.Ms + p.H_K);
+}
+
+// max_k |m_k x H_eff,k| / scale: zero both where H_eff = 0 (below saturation)
+// and where H_eff is parallel to every m_k (saturation, easy axis).
+ODEMAG_HD double cell_torque_residual(const SoftCellParams& p, const Vec3& H_A, const Vec3* m) {
+  const Vec3 mean_m = mean_moment(m, p.n);
+  double worst = 0.0;
+  for (int k = 0; k < p.n; ++k)
+    worst = fmax(worst, norm(cross(m[k], effective_field(p, H_A, mean_m, m[k]))));
+  return worst / torque_scale(p, H_A, mean_m);
+}
+
+// ---- Newton polish ------------------------------------------------------------
+
+// Rotate m by the tangent vector d (exponential map on the unit sphere).
+ODEMAG_HD Vec3 rotate_on_sphere(const Vec3& m, const Vec3& d) {
+  const double t = norm(d);
+  if (t == 0.0) return m;
+  return normalized(cos(t) * m + (sin(t) / t) * d);
+}
+
+// Two unit vectors spanning the tangent plane at m.
+ODEMAG_HD void tangent_basis(const Vec3& m, Vec3& u, Vec3& v) {
+  const double ax = fabs(m.x), ay = fabs(m.y), az = fabs(m.z);
+  const Vec3 axis = (ax <= ay && ax <= az) ? Vec3{1, 0, 0} : (ay <= az ? Vec3{0, 1, 0} : Vec3{0, 0, 1});
+  u = normalized(cross(m, axis));
+  v = cross(m, u);
+}
+
+// Newton's method on the product of unit spheres for the cell free energy,
+// with the Riemannian Hessian Hess[xi]_k = P_k (d2G xi)_k - (m_k . grad_k G) xi_k.
+// Steps use |eigenvalue| (descent at saddles), a 0.5 rad trust radius, and an
+// energy line search, so the energy never rises; at a converged saddle a step
+// along the negative-curvature direction leaves it (the role the noise field
+// plays for LLG). Converges quadratically in the basin the LLG steps chose;
+// it removes the slow "pair axis" mode that makes n = 2 LLG crawl in weak
+// fields (docs/model.md). Returns the steps taken.
+ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, int max_steps,
+                            double tolerance, double& residual) {
+  const int n = p.n, dim = 2 * n;
+  constexpr int kMaxDim = 2 * kMaxMomentsPerCell;
+  Vec3 basis[kMaxDim], heff[kMaxMomentsPerCell], trial[kMaxMomentsPerCell];
+  double hess[kMaxDim * kMaxDim], eval[kMaxDim], evec[kMaxDim * kMaxDim], grad[kMaxDim],
+      step[kMaxDim];
+  const double inv_n = 1.0 / n;
+  int steps = 0;
+  residual = cell_torque_residual(p, H_A, m);
+  for (; steps < max_steps; ++steps) {
+    const Vec3 mean_m = mean_moment(m, n);
+    const double scale = torque_scale(p, H_A, mean_m);
+    for (int k = 0; k < n; ++k) {
+      heff[k] = effective_field(p, H_A, mean_m, m[k]);
+      tangent_basis(m[k], basis[2 * k], basis[2 * k + 1]);
+    }
+    for (int a = 0; a < dim; ++a) {
+      const int k = a / 2;
+      grad[a] = -inv_n * dot(basis[a], heff[k]);
+      for (int b = 0; b < dim; ++b) {
+        const int l = b / 2;
+        double h = p.gamma_D * p.Ms * inv_n * inv_n * dot(basis[a], basis[b]);
+        if (k == l) {
+          h += p.H_K * inv_n *
+               (dot(basis[a], basis[b]) - dot(basis[a], p.easy_axis) * dot(basis[b], p.easy_axis));
+          if (a == b) h += inv_n * dot(m[k], heff[k]);
+        }
+        hess[a * dim + b] = h;
+      }
+    }
+    symmetric_eigen(hess, dim, eval, evec);
+    const double curvature_scale = inv_n * (p.gamma_D * p.Ms + p.H_K + norm(H_A));
+    int lowest = 0;
+    for (int i = 1; i < dim; ++i)
+      if (eval[i] < eval[lowest]) lowest = i;
+    const bool saddle = eval[lowest] < -1e-8 * curvature_scale;
+    if (residual <= tolerance && !saddle) break;
+    double longest = 0.0;
+    if (residual <= tolerance) {
+      // Converged onto a saddle: leave along the negative-curvature direction.
+      double sign = 0.0;
+      for (int a = 0; a < dim; ++a)
+        if (fabs(evec[a * dim + lowest]) > fabs(sign)) sign = evec[a * dim + lowest];
+      for (int a = 0; a < dim; ++a) step[a] = (sign >= 0 ? 0.1 : -0.1) * evec[a * dim + lowest];
+    } else {
+      for (int a = 0; a < dim; ++a) step[a] = 0.0;
+      for (int i = 0; i < dim; ++i) {
+        double vg = 0.0;
+        for (int a = 0; a < dim; ++a) vg += evec[a * dim + i] * grad[a];
+        const double lam = fmax(fabs(eval[i]), 1e-14 * curvature_scale);
+        for (int a = 0; a < dim; ++a) step[a] -= (vg / lam) * evec[a * dim + i];
+      }
+    }
+    for (int k = 0; k < n; ++k) longest = fmax(longest, hypot(step[2 * k], step[2 * k + 1]));
+    double t = longest > 0.5 ? 0.5 / longest : 1.0;
+    const double e0 = cell_free_energy(p, H_A, m);
+    bool accepted = false;
+    for (int ls = 0; ls < 40 && !accepted; ++ls, t *= 0.5) {
+      for (int k = 0; k < n; ++k)
+        trial[k] = rotate_on_sphere(m[k], (t * step[2 * k]) * basis[2 * k] +
+                                              (t * step[2 * k + 1]) * basis[2 * k + 1]);
+      const double e1 = cell_free_energy(p, H_A, trial);
+      if (e1 <= e0 + 1e-15 * (fabs(e0) + scale)) accepted = true;
+    }
+    if (!accepted) break;
+    for (int k = 0; k < n; ++k) m[k] = trial[k];
+    residual = cell_torque_residual(p, H_A, m);
+  }
+  return steps;
+}
+
+// ---- the inner relaxation of one cell -----------------------------------------
+
+// Relax the moments of one soft cell under the frozen applied field H_A.
+// single_step: one LLG step with history (paper Algorithm 1, one iteration).
+// Otherwise: LLG steps until the relative torque falls below llg_switch (these
+// choose the basin, so remanence stays path-dependent), then Newton polish to
+// the tolerance. counter numbers the noise draws of this cell.
+ODEMAG_HD LocalRelaxResult relax_soft_cell(const SoftCellParams& p, const Vec3& H_A, Vec3* m,
+                                           Vec3* hc_prev, bool& has_history, uint64_t& counter,
+                                           uint64_t noise_stream, const LocalRelaxOptions& o) {
+  LocalRelaxResult r;
+  const double c = cayley_coefficient(p, H_A, o.time_step_factor);
+  r.residual = cell_torque_residual(p, H_A, m);
+  if (o.single_step) {
+    if (r.residual > o.tolerance) {
+      llg_step(p, H_A, m, hc_prev, has_history, c, o.noise_ratio, mix64(noise_stream ^ counter++));
+      r.llg_steps = 1;
+    }
+    return r;
+  }
+  bool history = false;
+  while (r.residual > o.llg_switch && r.llg_steps < o.max_llg_steps) {
+    llg_step(p, H_A, m, hc_prev, history, c, o.noise_ratio, mix64(noise_stream ^ counter++));
+    ++r.llg_steps;
+    r.residual = cell_torque_residual(p, H_A, m);
+  }
+  if (o.newton) r.newton_steps = newton_polish(p, H_A, m, o.max_newton_steps, o.tolerance, r.residual);
+  has_history = false;
+  return r;
+}
+
+// Magnetization of a permanent cell with recoil: M = M_r + chi_r H_inside with
+// H_inside = H_A - M/3 (spherical cell), so M = (M_r + chi_r H_A) / (1 + chi_r/3).
+ODEMAG_HD Vec3 recoil_magnetization(const Vec3& remanent, double chi_r, const Vec3& H_A) {
+  return (1.0 / (1.0 + chi_r / 3.0)) * (remanent + chi_r * H_A);
+}
+
+}  // namespace odemag

@@ -1,0 +1,48 @@
+// Magnetic materials (MODEL.md "Objects and materials"). All values in SI units.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <variant>
+
+#include "magnetics/llg.h"
+#include "magnetics/vec3.h"
+
+namespace odemag {
+
+// Hard magnet: fixed magnetization M_r in the body frame, optional recoil
+// susceptibility chi_r so that M = M_r + chi_r * H_inside.
+struct PermanentMaterial {
+  Vec3 magnetization;                 // M_r, A/m, body frame
+  double recoil_susceptibility = 0.0;  // chi_r, dimensionless, >= 0
+};
+
+// Ferromagnet magnetized by the field: n unit moments per cell evolved by LLG.
+struct SoftMaterial {
+  double saturation = 0.0;                                          // Ms, A/m, > 0
+  double susceptibility = std::numeric_limits<double>::infinity();  // chi, > 0, may be infinite
+  double anisotropy_field = 0.0;                                    // H_K, A/m, >= 0
+  Vec3 easy_axis{0.0, 0.0, 1.0};                                    // body frame, normalised on use
+  double damping = 1.0;                                             // Gilbert alpha, > 0
+  int moments_per_cell = 2;                                         // n, even, 2..kMaxMomentsPerCell
+
+  // Demagnetising factor of a spherical cell including the intrinsic
+  // susceptibility: gamma_D = 1/3 + 1/chi (MODEL.md, H_endo).
+  double demag_factor() const;
+  bool anisotropic() const { return anisotropy_field > 0.0; }
+};
+
+// No cells, no magnetic cost (wood, glass, floors).
+struct InertMaterial {};
+
+using Material = std::variant<InertMaterial, PermanentMaterial, SoftMaterial>;
+
+// kMaxMomentsPerCell: see magnetics/llg.h
+
+// Empty when the material is valid; otherwise a message naming the offending
+// parameter by its scene-file key (e.g. "saturation must be positive").
+std::string validate_material(const Material& material);
+
+bool is_inert(const Material& material);
+
+}  // namespace odemag

@@ -1,0 +1,81 @@
+// The magnetic model: what does not change during a simulation (bodies,
+// materials, cells, cached intra-body tensors). The changing part lives in
+// MagneticState; solvers take both (docs/architecture.md).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "magnetics/cells.h"
+#include "magnetics/llg.h"
+#include "magnetics/material.h"
+#include "magnetics/shape.h"
+
+namespace odemag {
+
+// How a cell's magnetization is determined.
+enum class CellKind : uint8_t {
+  fixed_permanent,   // M = M_r (rotating with the body); a source only
+  recoil_permanent,  // M = (M_r + chi_r H_A) / (1 + chi_r / 3)
+  soft,              // n unit moments relaxed by LLG
+};
+
+struct MagneticBody {
+  std::string name;
+  Shape shape;
+  Material material;
+  CellSet cells;         // empty for inert bodies
+  int first_cell = 0;    // index of the first cell in the model's cell arrays
+  CellKind kind = CellKind::fixed_permanent;
+  SoftCellParams soft;   // for soft bodies (easy axis normalised, body frame)
+  Vec3 remanence;        // M_r for permanent bodies, body frame
+  double recoil = 0.0;   // chi_r for permanent bodies
+
+  // Intra-body demagnetising tensors, computed once per body: the exact dipole
+  // tensor T(h * d) for every lattice offset d, six components each, body frame.
+  std::vector<double> offset_tensors;
+  std::array<int, 3> offset_extent{0, 0, 0};  // 2 n - 1 per axis
+
+  int cell_count() const { return cells.size(); }
+  bool inert() const { return cells.size() == 0; }
+  bool responsive() const { return !inert() && kind != CellKind::fixed_permanent; }
+  // Index into offset_tensors (times 6) of the offset a - b.
+  int offset_index(const std::array<int, 3>& a, const std::array<int, 3>& b) const {
+    const int nx = cells.lattice_extent[0], ny = cells.lattice_extent[1], nz = cells.lattice_extent[2];
+    return (a[0] - b[0] + nx - 1) +
+           offset_extent[0] * ((a[1] - b[1] + ny - 1) + offset_extent[1] * (a[2] - b[2] + nz - 1));
+  }
+};
+
+class MagneticModel {
+ public:
+  // Adds a body and returns its index. cell_size <= 0: one cell (spheres) or
+  // one cell at the centre. Throws std::invalid_argument on a bad shape or material.
+  int add_body(const std::string& name, const Shape& shape, const Material& material,
+               double cell_size);
+
+  const std::vector<MagneticBody>& bodies() const { return bodies_; }
+  const MagneticBody& body(int b) const { return bodies_[b]; }
+  int body_count() const { return static_cast<int>(bodies_.size()); }
+  int find_body(const std::string& name) const;  // -1 when absent
+
+  int cell_count() const { return static_cast<int>(cell_body_.size()); }
+  int cell_body(int c) const { return cell_body_[c]; }
+  // Index of the cell's first moment in the state's moment array, -1 if not soft.
+  int moment_offset(int c) const { return moment_offset_[c]; }
+  int moment_count() const { return moment_count_; }
+  int soft_cell_count() const { return soft_cells_; }
+  int responsive_cell_count() const { return responsive_cells_; }
+
+ private:
+  std::vector<MagneticBody> bodies_;
+  std::vector<int> cell_body_;
+  std::vector<int> moment_offset_;
+  int moment_count_ = 0;
+  int soft_cells_ = 0;
+  int responsive_cells_ = 0;
+};
+
+}  // namespace odemag

@@ -1,0 +1,198 @@
+#include "magnetics/relax.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "magnetics/anderson.h"
+#include "magnetics/kernels.h"
+
+namespace odemag {
+
+namespace {
+
+std::vector<int> active_responsive_cells(const MagneticModel& model, const MagneticState& state) {
+  std::vector<int> cells;
+  for (int b = 0; b < model.body_count(); ++b) {
+    const MagneticBody& body = model.body(b);
+    if (!body.responsive() || !state.active[b]) continue;
+    for (int i = 0; i < body.cell_count(); ++i) cells.push_back(body.first_cell + i);
+  }
+  return cells;
+}
+
+// |H_A| + gamma_D |M| for soft cells, |H_A| + |M| / 3 for recoil magnets: the
+// field scale against which a cell's applied-field change is measured.
+double cell_field_scale(const MagneticModel& model, const MagneticState& state, int c,
+                        const Vec3& H_A) {
+  const MagneticBody& body = model.body(model.cell_body(c));
+  const double gamma = body.kind == CellKind::soft ? body.soft.gamma_D : 1.0 / 3.0;
+  return norm(H_A) + gamma * norm(state.magnetization[c]);
+}
+
+RelaxReport relax_paper(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
+                        MagneticBackend& backend, const std::vector<int>& cells,
+                        const std::vector<Vec3>& H_fixed) {
+  RelaxReport report;
+  std::vector<Vec3> H(model.cell_count()), H_A(model.cell_count());
+  LocalRelaxOptions local = o.local;
+  local.single_step = true;
+  local.tolerance = o.tolerance;
+  for (report.iterations = 0; report.iterations < o.max_iterations; ++report.iterations) {
+    backend.responsive_field(model, state, H);
+    ++report.field_evaluations;
+    for (int c : cells) H_A[c] = H_fixed[c] + (o.mutual_induction ? H[c] : Vec3{});
+    const LocalStats s = backend.relax_cells(model, state, H_A, local);
+    report.llg_steps += s.llg_steps;
+    report.residual = s.max_residual;
+    if (s.llg_steps == 0) {
+      report.converged = true;
+      break;
+    }
+  }
+  for (int c : cells) state.applied_field[c] = H_A[c];
+  return report;
+}
+
+}  // namespace
+
+RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
+                  MagneticBackend& backend) {
+  place_cells(model, state);
+  backend.begin_step(model, state);
+  const std::vector<int> cells = active_responsive_cells(model, state);
+  if (cells.empty()) return {0, 0, 0.0, true, 0, 0};
+
+  std::vector<Vec3> H_fixed(model.cell_count());
+  backend.fixed_field(model, state, H_fixed);
+  if (o.scheme == RelaxScheme::paper) return relax_paper(model, state, o, backend, cells, H_fixed);
+
+  RelaxReport report;
+  LocalRelaxOptions local = o.local;
+  local.single_step = false;
+  std::vector<Vec3> H_A(model.cell_count()), H_resp(model.cell_count());
+  if (!o.mutual_induction) {
+    for (int c : cells) H_A[c] = H_fixed[c];
+    const LocalStats s = backend.relax_cells(model, state, H_A, local);
+    for (int c : cells) state.applied_field[c] = H_A[c];
+    return {1, 0, s.max_residual, s.max_residual <= o.local.tolerance || s.max_residual <= o.tolerance,
+            s.llg_steps, s.newton_steps};
+  }
+
+  // x: applied field at the responsive cells, flattened; G(x): the applied
+  // field after relaxing every cell under x.
+  const int n = static_cast<int>(cells.size());
+  std::vector<double> x(3 * n), f(3 * n), weights(3 * n);
+  backend.responsive_field(model, state, H_resp);
+  ++report.field_evaluations;
+  double largest_scale = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const int c = cells[i];
+    const Vec3 h = H_fixed[c] + H_resp[c];
+    for (int a = 0; a < 3; ++a) x[3 * i + a] = h[a];
+    largest_scale = std::max(largest_scale, cell_field_scale(model, state, c, h));
+  }
+  const double floor = 1e-9 * largest_scale + 1e-300;
+  for (int i = 0; i < n; ++i) {
+    const int c = cells[i];
+    const double w = 1.0 / (cell_field_scale(model, state, c, {x[3 * i], x[3 * i + 1], x[3 * i + 2]}) + floor);
+    weights[3 * i] = weights[3 * i + 1] = weights[3 * i + 2] = w;
+  }
+  AndersonMixer mixer(o.anderson_depth, o.mixing);
+  mixer.set_weights(weights);
+
+  for (report.iterations = 1; report.iterations <= o.max_iterations; ++report.iterations) {
+    for (int i = 0; i < n; ++i) H_A[cells[i]] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+    const LocalStats s = backend.relax_cells(model, state, H_A, local);
+    report.llg_steps += s.llg_steps;
+    report.newton_steps += s.newton_steps;
+    backend.responsive_field(model, state, H_resp);
+    ++report.field_evaluations;
+    // Residual: change of each cell's applied field against its field scale.
+    double worst = 0.0, largest = 0.0;
+    std::vector<Vec3> G(n);
+    for (int i = 0; i < n; ++i) {
+      const int c = cells[i];
+      G[i] = H_fixed[c] + H_resp[c];
+      largest = std::max(largest, cell_field_scale(model, state, c, G[i]));
+    }
+    const double fl = 1e-9 * largest + 1e-300;
+    for (int i = 0; i < n; ++i) {
+      const int c = cells[i];
+      const Vec3 d = G[i] - H_A[c];
+      for (int a = 0; a < 3; ++a) f[3 * i + a] = d[a];
+      worst = std::max(worst, norm(d) / (cell_field_scale(model, state, c, G[i]) + fl));
+    }
+    report.residual = worst;
+    if (worst <= o.tolerance) {
+      report.converged = true;
+      for (int i = 0; i < n; ++i) H_A[cells[i]] = G[i];
+      break;
+    }
+    mixer.next(x, f);
+  }
+  report.iterations = std::min(report.iterations, o.max_iterations);
+  for (int c : cells) state.applied_field[c] = H_A[c];
+  return report;
+}
+
+RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
+                          const RelaxOptions& options, MagneticBackend& backend) {
+  RelaxReport report = relax(model, state, options, backend);
+  backend.forces(model, state);
+  return report;
+}
+
+void field_at_points(const MagneticModel& model, const MagneticState& state,
+                     MagneticBackend& backend, const std::vector<Vec3>& points,
+                     std::vector<Vec3>& B, std::vector<Vec3>& H) {
+  backend.field_at_points(model, state, points, H);
+  B.resize(points.size());
+  for (size_t p = 0; p < points.size(); ++p) {
+    Vec3 M;
+    for (int b = 0; b < model.body_count(); ++b) {
+      const MagneticBody& body = model.body(b);
+      if (body.inert() || !state.active[b]) continue;
+      const BodyPose& pose = state.pose[b];
+      const Vec3 local = pose.rotation.transpose_times(points[p] - pose.position);
+      if (!shape_contains(body.shape, local)) continue;
+      int nearest = 0;
+      double best = 1e300;
+      for (int i = 0; i < body.cell_count(); ++i) {
+        const double d = squared_norm(body.cells.local_positions[i] - local);
+        if (d < best) best = d, nearest = i;
+      }
+      M = state.magnetization[body.first_cell + nearest];
+      break;
+    }
+    B[p] = kMu0 * (H[p] + M);
+  }
+}
+
+double magnetic_energy(const MagneticModel& model, const MagneticState& state) {
+  double e = 0.0;
+  const int n = model.cell_count();
+  for (int a = 0; a < n; ++a) {
+    const int ba = model.cell_body(a);
+    if (!state.active[ba]) continue;
+    const MagneticBody& body_a = model.body(ba);
+    const Vec3 mu_a = body_a.cells.cell_volume * state.magnetization[a];
+    e -= kMu0 * dot(mu_a, state.external_field);
+    for (int b = a + 1; b < n; ++b) {
+      const int bb = model.cell_body(b);
+      if (!state.active[bb]) continue;
+      const MagneticBody& body_b = model.body(bb);
+      const Vec3 mu_b = body_b.cells.cell_volume * state.magnetization[b];
+      const double s = ba == bb ? 0.0 : body_a.cells.cell_radius + body_b.cells.cell_radius;
+      e += dipole_energy(state.cell_position[b] - state.cell_position[a], mu_a, mu_b, s * s);
+    }
+    if (body_a.kind == CellKind::soft) {
+      // Self energy mu0 V (gamma_D Ms^2 |mean m|^2 / 2 + anisotropy).
+      SoftCellParams p = body_a.soft;
+      e += kMu0 * body_a.cells.cell_volume * p.Ms *
+           cell_free_energy(p, Vec3{}, &state.moments[model.moment_offset(a)]);
+    }
+  }
+  return e;
+}
+
+}  // namespace odemag

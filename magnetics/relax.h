@@ -1,0 +1,68 @@
+// Relaxation of the magnetization for bodies held in place (MODEL.md
+// "Relaxation loop"; paper Algorithm 1), and the rest of a magnetic step.
+#pragma once
+
+#include "magnetics/backend.h"
+#include "magnetics/llg.h"
+#include "magnetics/model.h"
+#include "magnetics/state.h"
+
+namespace odemag {
+
+enum class RelaxScheme {
+  // Outer loop over the exo field (one field evaluation per iteration,
+  // Anderson-accelerated); inner loop relaxes each cell locally under the
+  // frozen applied field with LLG steps and a Newton polish. Default.
+  two_level,
+  // The paper's Algorithm 1: every iteration evaluates the field and moves
+  // every moment by one LLG step.
+  paper,
+};
+
+struct RelaxOptions {
+  RelaxScheme scheme = RelaxScheme::two_level;
+  // Converged when every responsive cell's applied field changes by less than
+  // tolerance times its field scale |H_A| + gamma_D |M| (two_level), or every
+  // soft cell's relative torque is below tolerance (paper).
+  double tolerance = 1e-6;
+  int max_iterations = 200;
+  int anderson_depth = 6;   // 0: plain fixed-point iteration
+  double mixing = 1.0;      // Anderson beta
+  // false: induced (responsive) cells feel only H_E and the fixed permanent
+  // magnets, not each other (the paper's Fig. 12c comparison).
+  bool mutual_induction = true;
+  LocalRelaxOptions local;
+};
+
+struct RelaxReport {
+  int iterations = 0;         // outer iterations (paper scheme: LLG iterations)
+  int field_evaluations = 0;  // responsive-field evaluations, O(N^2) each
+  double residual = 0.0;      // final value of the convergence measure
+  bool converged = false;
+  long llg_steps = 0;         // per-cell LLG steps, summed over cells
+  long newton_steps = 0;      // per-cell Newton steps, summed over cells
+};
+
+// Relaxes the magnetization of every active responsive cell at the current
+// poses, starting from the state's moments (warm start: this temporal
+// coherence is what makes remanence possible). Updates magnetization,
+// moments and applied_field.
+RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxOptions& options,
+                  MagneticBackend& backend);
+
+// relax, then per-body forces and torques (MODEL.md "One rigid step", 1-4).
+RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
+                          const RelaxOptions& options, MagneticBackend& backend);
+
+// B (T) and H (A/m) at world points after a relaxation. Inside a magnetic body
+// B = mu0 (H + M) with M of the body's nearest cell.
+void field_at_points(const MagneticModel& model, const MagneticState& state,
+                     MagneticBackend& backend, const std::vector<Vec3>& points,
+                     std::vector<Vec3>& B, std::vector<Vec3>& H);
+
+// Total magnetic energy (J) of the configuration with the current
+// magnetizations: pair interactions, H_E and, for soft cells, the cell free
+// energies. Used by tests (App. B) and diagnostics.
+double magnetic_energy(const MagneticModel& model, const MagneticState& state);
+
+}  // namespace odemag

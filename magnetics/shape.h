@@ -1,0 +1,35 @@
+// Body shapes, centred on the body's centre of mass (body frame).
+#pragma once
+
+#include <string>
+#include <variant>
+
+#include "magnetics/vec3.h"
+
+namespace odemag {
+
+struct Sphere {
+  double radius = 0.0;
+};
+// Full edge lengths along the body x, y, z axes.
+struct Box {
+  Vec3 size;
+};
+// Axis along the body z axis.
+struct Cylinder {
+  double radius = 0.0;
+  double length = 0.0;
+};
+
+using Shape = std::variant<Sphere, Box, Cylinder>;
+
+double shape_volume(const Shape& shape);
+// Half extents of the axis-aligned bounding box in the body frame.
+Vec3 shape_half_extents(const Shape& shape);
+// True when the body-frame point lies inside the shape (boundary included up to tol).
+bool shape_contains(const Shape& shape, const Vec3& local, double tol = 0.0);
+// Empty when valid, else a message naming the offending key.
+std::string validate_shape(const Shape& shape);
+const char* shape_kind(const Shape& shape);
+
+}  // namespace odemag

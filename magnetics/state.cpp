@@ -1,0 +1,86 @@
+#include "magnetics/state.h"
+
+#include "magnetics/rng.h"
+
+namespace odemag {
+
+void reset_moments(const MagneticModel& model, MagneticState& state, int b) {
+  const MagneticBody& body = model.body(b);
+  if (body.kind != CellKind::soft) return;
+  for (int i = 0; i < body.cell_count(); ++i) {
+    const int c = body.first_cell + i;
+    const int off = model.moment_offset(c);
+    for (int k = 0; k < body.soft.n; k += 2) {
+      const Vec3 d = random_unit_vector(hash_key(state.seed, 0x4d4f4d454e54ULL, c, k));
+      state.moments[off + k] = d;
+      state.moments[off + k + 1] = -d;
+    }
+    for (int k = 0; k < body.soft.n; ++k) state.moment_hc_prev[off + k] = {};
+    state.llg_history[c] = 0;
+    state.magnetization[c] = {};
+  }
+}
+
+void extend_state(const MagneticModel& model, MagneticState& state) {
+  const int old_bodies = static_cast<int>(state.pose.size());
+  state.pose.resize(model.body_count());
+  state.active.resize(model.body_count(), 1);
+  state.magnetization_scale.resize(model.body_count(), 1.0);
+  state.force.resize(model.body_count());
+  state.torque.resize(model.body_count());
+  state.cell_position.resize(model.cell_count());
+  state.magnetization.resize(model.cell_count());
+  state.applied_field.resize(model.cell_count());
+  state.llg_history.resize(model.cell_count(), 0);
+  state.noise_counter.resize(model.cell_count(), 0);
+  state.moments.resize(model.moment_count());
+  state.moment_hc_prev.resize(model.moment_count());
+  for (int b = old_bodies; b < model.body_count(); ++b) reset_moments(model, state, b);
+}
+
+MagneticState make_state(const MagneticModel& model, uint64_t seed) {
+  MagneticState state;
+  state.seed = seed;
+  extend_state(model, state);
+  place_cells(model, state);
+  return state;
+}
+
+Vec3 soft_cell_magnetization(const MagneticModel& model, const MagneticState& state, int c) {
+  const MagneticBody& body = model.body(model.cell_body(c));
+  const Vec3 m = mean_moment(&state.moments[model.moment_offset(c)], body.soft.n);
+  return state.pose[model.cell_body(c)].rotation * (body.soft.Ms * m);
+}
+
+void place_cells(const MagneticModel& model, MagneticState& state) {
+  for (int b = 0; b < model.body_count(); ++b) {
+    const MagneticBody& body = model.body(b);
+    const BodyPose& pose = state.pose[b];
+    const Vec3 remanent = pose.rotation * (state.magnetization_scale[b] * body.remanence);
+    for (int i = 0; i < body.cell_count(); ++i) {
+      const int c = body.first_cell + i;
+      state.cell_position[c] = pose.position + pose.rotation * body.cells.local_positions[i];
+      switch (body.kind) {
+        case CellKind::fixed_permanent:
+          state.magnetization[c] = remanent;
+          break;
+        case CellKind::recoil_permanent:
+          state.magnetization[c] =
+              recoil_magnetization(remanent, body.recoil, state.applied_field[c]);
+          break;
+        case CellKind::soft:
+          state.magnetization[c] = soft_cell_magnetization(model, state, c);
+          break;
+      }
+    }
+  }
+}
+
+Vec3 body_moment(const MagneticModel& model, const MagneticState& state, int b) {
+  const MagneticBody& body = model.body(b);
+  Vec3 mu;
+  for (int i = 0; i < body.cell_count(); ++i) mu += state.magnetization[body.first_cell + i];
+  return body.cells.cell_volume * mu;
+}
+
+}  // namespace odemag

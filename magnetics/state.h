@@ -1,0 +1,62 @@
+// The magnetic state: everything that changes during a simulation.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "magnetics/model.h"
+#include "magnetics/vec3.h"
+
+namespace odemag {
+
+struct BodyPose {
+  Mat3 rotation;  // body frame -> world frame
+  Vec3 position;  // centre of mass, world, m
+};
+
+struct MagneticState {
+  Vec3 external_field;  // uniform H_E, A/m
+
+  // Per body.
+  std::vector<BodyPose> pose;
+  std::vector<uint8_t> active;               // 0: removed from the scene (no field, no force)
+  std::vector<double> magnetization_scale;   // multiplies M_r of permanent magnets
+  std::vector<Vec3> force;                   // world, N
+  std::vector<Vec3> torque;                  // world, N m, about the centre of mass
+
+  // Per cell.
+  std::vector<Vec3> cell_position;   // world, m
+  std::vector<Vec3> magnetization;   // world, A/m
+  std::vector<Vec3> applied_field;   // H_A = H_E + H_exo at responsive cells, world, A/m
+  std::vector<uint8_t> llg_history;  // Hc^(i-1) is valid (paper Algorithm 1 scheme)
+  std::vector<uint64_t> noise_counter;
+
+  // Per moment of soft cells (model.moment_offset), body frame.
+  std::vector<Vec3> moments;         // unit vectors m_k
+  std::vector<Vec3> moment_hc_prev;  // Hc^(i-1) for the extrapolation
+
+  uint64_t seed = 1;
+};
+
+// A state for the model: identity poses at the origin, all bodies active,
+// soft moments in opposite pairs along random directions (so M = 0).
+MagneticState make_state(const MagneticModel& model, uint64_t seed = 1);
+
+// Extends a state made for a smaller model to every body of the model (bodies
+// added to the model later, e.g. by the embedding API).
+void extend_state(const MagneticModel& model, MagneticState& state);
+
+// Soft cells back to the unmagnetized random opposite pairs of make_state.
+void reset_moments(const MagneticModel& model, MagneticState& state, int body);
+
+// World cell positions from the body poses, and the magnetization of every
+// cell that follows from its material and pose (MODEL.md "One rigid step", 1).
+void place_cells(const MagneticModel& model, MagneticState& state);
+
+// Magnetization of one cell from the state (soft: Ms mean(m_k) rotated to world).
+Vec3 soft_cell_magnetization(const MagneticModel& model, const MagneticState& state, int cell);
+
+// Total moment of a body, sum of M V over its cells, world, A m^2.
+Vec3 body_moment(const MagneticModel& model, const MagneticState& state, int body);
+
+}  // namespace odemag

@@ -1,0 +1,183 @@
+// Tests of the per-cell LLG physics (magnetics/llg.h): MODEL.md "Properties
+// the tests must show" and the paper's App. B, App. C, Figs. 10 and 11.
+#include "magnetics/llg.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "magnetics/relax.h"
+
+namespace odemag {
+namespace {
+
+SoftCellParams iron(double Ms = 1.7e6, double chi = 5000.0, double H_K = 0.0, int n = 2) {
+  SoftCellParams p;
+  p.Ms = Ms;
+  p.gamma_D = 1.0 / 3.0 + 1.0 / chi;
+  p.H_K = H_K;
+  p.easy_axis = {0, 0, 1};
+  p.alpha = 1.0;
+  p.n = n;
+  return p;
+}
+
+
+TEST(CayleyStep, KeepsUnitLengthOver10000Updates) {
+  SoftCellParams p = iron(1.7e6, 5000.0, 3e5);
+  std::vector<Vec3> m = {normalized(Vec3{1, 2, 3}), normalized(Vec3{-3, 1, 0.5})};
+  Vec3 hc_prev[2];
+  bool history = false;
+  const Vec3 H_A{2e5, -1e5, 7e4};
+  const double c = cayley_coefficient(p, H_A, 0.8);
+  double worst = 0.0;
+  for (int i = 0; i < 10000; ++i) {
+    llg_step(p, H_A, m.data(), hc_prev, history, c, 1e-6, static_cast<uint64_t>(i));
+    for (const Vec3& v : m) worst = std::max(worst, std::abs(norm(v) - 1.0));
+  }
+  EXPECT_LT(worst, 1e-12);
+}
+
+TEST(CayleyStep, EqualsDirectSolveOfMidpointEquation) {
+  // m' - m = a x (m' + m)  <=>  (I - [a]x) m' = (I + [a]x) m.
+  for (const Vec3& a : {Vec3{0.1, -0.2, 0.3}, Vec3{2.0, 1.0, -4.0}, Vec3{1e-7, 0, 0}}) {
+    const Vec3 m = normalized(Vec3{0.3, 0.4, -0.8});
+    Eigen::Matrix3d ax;
+    ax << 0, -a.z, a.y, a.z, 0, -a.x, -a.y, a.x, 0;
+    const Eigen::Vector3d mv(m.x, m.y, m.z);
+    const Eigen::Vector3d direct =
+        (Eigen::Matrix3d::Identity() - ax).partialPivLu().solve((Eigen::Matrix3d::Identity() + ax) * mv);
+    const Vec3 closed = cayley_step(m, a);
+    EXPECT_NEAR(closed.x, direct.x(), 1e-14);
+    EXPECT_NEAR(closed.y, direct.y(), 1e-14);
+    EXPECT_NEAR(closed.z, direct.z(), 1e-14);
+    // And it satisfies the midpoint equation itself.
+    const Vec3 residual = closed - m - cross(a, closed + m);
+    EXPECT_LT(norm(residual), 1e-14);
+  }
+}
+
+// Paper App. B: under a constant field the cell's free energy never rises.
+TEST(LlgStep, FreeEnergyNeverRisesUnderConstantField) {
+  struct Case {
+    Vec3 H_A;
+    double H_K;
+  };
+  for (const Case& k : {Case{{1e3, 0, 0}, 0.0}, Case{{2e5, 1e5, 0}, 0.0}, Case{{3e6, 0, 1e6}, 0.0},
+                        Case{{1e5, 0, -2e5}, 8e5}, Case{{0, 0, 0}, 8e5}}) {
+    SoftCellParams p = iron(1.7e6, 5000.0, k.H_K);
+    std::vector<Vec3> m = {normalized(Vec3{0.2, 0.9, 0.1}), normalized(Vec3{-0.5, 0.1, 0.8})};
+    Vec3 hc_prev[2];
+    bool history = false;
+    const double c = cayley_coefficient(p, k.H_A, LocalRelaxOptions{}.time_step_factor);
+    const double scale = llg_field_scale(p, k.H_A);
+    double g = cell_free_energy(p, k.H_A, m.data());
+    for (int i = 0; i < 3000; ++i) {
+      llg_step(p, k.H_A, m.data(), hc_prev, history, c, 0.0, 0);
+      const double g_next = cell_free_energy(p, k.H_A, m.data());
+      ASSERT_LE(g_next, g + 1e-13 * scale) << "step " << i;
+      g = g_next;
+    }
+  }
+}
+
+// Paper App. C: with H_A = 0 and no anisotropy the net moment decays to zero,
+// monotonically (Eq. 27).
+TEST(LlgStep, NetMomentDecaysWithoutAppliedField) {
+  for (int n : {2, 4}) {
+    SoftCellParams p = iron(1.7e6, 5000.0, 0.0, n);
+    std::vector<Vec3> m;
+    for (int k = 0; k < n; ++k) m.push_back(normalized(Vec3{1.0, 0.3 * k, 0.5 - 0.2 * k}));
+    std::vector<Vec3> hc_prev(n);
+    bool history = false;
+    const double c = cayley_coefficient(p, {}, LocalRelaxOptions{}.time_step_factor);
+    double previous = norm(mean_moment(m.data(), n));
+    ASSERT_GT(previous, 0.5);
+    for (int i = 0; i < 2000; ++i) {
+      llg_step(p, {}, m.data(), hc_prev.data(), history, c, 1e-6, static_cast<uint64_t>(i));
+      const double now = norm(mean_moment(m.data(), n));
+      ASSERT_LE(now, previous + 1e-12) << "n=" << n << " step " << i;
+      previous = now;
+    }
+    EXPECT_LT(previous, 1e-6) << "n=" << n;
+  }
+}
+
+// Relax a single soft cell (one-cell sphere) in a uniform external field.
+struct SingleCell {
+  MagneticModel model;
+  MagneticState state;
+  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
+  explicit SingleCell(const SoftMaterial& mat, uint64_t seed = 7) {
+    model.add_body("cell", Sphere{0.01}, mat, 0.0);
+    state = make_state(model, seed);
+  }
+  Vec3 relax_in(const Vec3& H) {
+    state.external_field = H;
+    RelaxOptions o;
+    o.tolerance = 1e-10;
+    const RelaxReport r = relax(model, state, o, *backend);
+    EXPECT_TRUE(r.converged);
+    return state.magnetization[0];
+  }
+};
+
+SoftMaterial soft(double Ms, double gamma_D, double H_K = 0.0) {
+  SoftMaterial m;
+  m.saturation = Ms;
+  m.susceptibility = 1.0 / (gamma_D - 1.0 / 3.0);
+  m.anisotropy_field = H_K;
+  return m;
+}
+
+// Paper Fig. 11 and Eq. 21: M = H / gamma_D below saturation, Ms above, on the
+// way up and on the way down.
+void check_curve(double Ms, double gamma_D) {
+  SingleCell cell(soft(Ms, gamma_D));
+  const double Hs = gamma_D * Ms;
+  std::vector<double> sweep;
+  for (int i = 1; i <= 40; ++i) sweep.push_back(2.0 * Hs * i / 40.0);
+  for (int i = 39; i >= 1; --i) sweep.push_back(2.0 * Hs * i / 40.0);
+  const Vec3 dir = normalized(Vec3{1.0, 0.5, -0.3});
+  for (double H : sweep) {
+    const Vec3 M = cell.relax_in(H * dir);
+    const double expected = std::min(H / gamma_D, Ms);
+    EXPECT_NEAR(dot(M, dir), expected, 5e-3 * expected) << "Ms=" << Ms << " gamma_D=" << gamma_D << " H=" << H;
+    EXPECT_LT(norm(M - dot(M, dir) * dir), 5e-3 * expected);
+  }
+}
+
+TEST(MagnetizationCurve, ThreeSaturationsAtOneDemagFactor) {
+  for (double Ms : {0.5e6, 1.0e6, 1.7e6}) check_curve(Ms, 0.5);
+}
+
+TEST(MagnetizationCurve, FourDemagFactorsAtOneSaturation) {
+  for (double gamma_D : {1.0 / 3.0 + 1e-4, 0.5, 1.0, 2.0}) check_curve(1.0e6, gamma_D);
+}
+
+// Paper Fig. 10 / Sec. 4.6: remanence. An anisotropic cell (H_K > gamma_D Ms)
+// keeps its magnetization when the field is removed; an isotropic one does not.
+TEST(Remanence, AnisotropicCellKeepsMagnetizationIsotropicDoesNot) {
+  const double Ms = 1.0e6, gamma_D = 1.0 / 3.0 + 1e-4;
+  SingleCell aniso(soft(Ms, gamma_D, 6e5));
+  SingleCell iso(soft(Ms, gamma_D, 0.0));
+  const Vec3 easy{0, 0, 1};
+  for (double H : {1e5, 5e5, 1e6, 2e6}) {
+    aniso.relax_in(H * easy);
+    iso.relax_in(H * easy);
+  }
+  EXPECT_GT(norm(aniso.state.magnetization[0]), 0.99 * Ms);
+  EXPECT_GT(norm(iso.state.magnetization[0]), 0.99 * Ms);
+  for (double H : {5e5, 1e5, 1e4, 0.0}) {
+    aniso.relax_in(H * easy);
+    iso.relax_in(H * easy);
+  }
+  EXPECT_GE(norm(aniso.state.magnetization[0]), 0.5 * Ms);
+  EXPECT_LT(norm(iso.state.magnetization[0]), 0.01 * Ms);
+}
+
+}  // namespace
+}  // namespace odemag
