@@ -11,6 +11,10 @@ namespace odemag {
 
 namespace {
 
+// Below this many pair interactions a loop runs on one thread: waking the
+// team costs more than it saves.
+constexpr long kParallelPairs = 20000;
+
 // Cells as structure of arrays, for the pair loops.
 struct CellArrays {
   std::vector<double> x, y, z, radius, mx, my, mz;  // position, radius, moment mu = M V
@@ -93,7 +97,7 @@ class CpuBackend final : public MagneticBackend {
 
   void fixed_field(const MagneticModel&, const MagneticState& state, std::vector<Vec3>& H) override {
     const int n = resp_.size();
-#pragma omp parallel for schedule(static) num_threads(threads_)
+#pragma omp parallel for schedule(static) num_threads(threads_) if (static_cast<long>(n) * fixed_.size() > kParallelPairs)
     for (int i = 0; i < n; ++i)
       H[resp_.cell[i]] = state.external_field +
                          sum_field(fixed_, 0, fixed_.size(), resp_.x[i], resp_.y[i], resp_.z[i],
@@ -109,7 +113,7 @@ class CpuBackend final : public MagneticBackend {
     for (int i = 0; i < n; ++i)
       body_moment_[i] = state.pose[resp_.body[i]].rotation.transpose_times(
           {resp_.mx[i], resp_.my[i], resp_.mz[i]});
-#pragma omp parallel for schedule(dynamic, 16) num_threads(threads_)
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads_) if (static_cast<long>(n) * n > kParallelPairs)
     for (int i = 0; i < n; ++i) {
       const auto [begin, end] = resp_range_[i];
       // Inter-body: every responsive cell of another body.
@@ -137,7 +141,7 @@ class CpuBackend final : public MagneticBackend {
     long llg = 0, newton = 0;
     double worst = 0.0;
 #pragma omp parallel for schedule(dynamic, 8) num_threads(threads_) reduction(+ : llg, newton) \
-    reduction(max : worst)
+    reduction(max : worst) if (n > 16)
     for (int i = 0; i < n; ++i) {
       const int c = resp_.cell[i], b = resp_.body[i];
       const MagneticBody& body = model.body(b);
@@ -166,7 +170,7 @@ class CpuBackend final : public MagneticBackend {
     const int n = all_.size();
     cell_force_.assign(n, {});
     cell_field_.assign(n, {});
-#pragma omp parallel for schedule(dynamic, 16) num_threads(threads_)
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads_) if (static_cast<long>(n) * n > kParallelPairs)
     for (int i = 0; i < n; ++i) {
       const Vec3 xi{all_.x[i], all_.y[i], all_.z[i]}, mi{all_.mx[i], all_.my[i], all_.mz[i]};
       Vec3 f, h;
@@ -198,7 +202,7 @@ class CpuBackend final : public MagneticBackend {
     all_.load_moments(model, state);
     const int n = static_cast<int>(points.size());
     H.resize(n);
-#pragma omp parallel for schedule(static) num_threads(threads_)
+#pragma omp parallel for schedule(static) num_threads(threads_) if (static_cast<long>(n) * all_.size() > kParallelPairs)
     for (int p = 0; p < n; ++p)
       // A point is a target of radius 0: the kernel is bounded inside each cell's sphere.
       H[p] = state.external_field +

@@ -9,7 +9,7 @@ namespace odemag {
 
 namespace {
 
-void build_offset_tensors(MagneticBody& body) {
+void build_offset_tensors(MagneticBody& body, IntraBodyTensor kind) {
   const auto& n = body.cells.lattice_extent;
   body.offset_extent = {2 * n[0] - 1, 2 * n[1] - 1, 2 * n[2] - 1};
   const double h = body.cells.spacing;
@@ -21,7 +21,14 @@ void build_offset_tensors(MagneticBody& body) {
         const int di = i - (n[0] - 1), dj = j - (n[1] - 1), dk = k - (n[2] - 1);
         if (di == 0 && dj == 0 && dk == 0) continue;  // self term is H_endo
         const int idx = i + body.offset_extent[0] * (j + body.offset_extent[1] * k);
-        dipole_tensor({di * h, dj * h, dk * h}, 0.0, &body.offset_tensors[6u * idx]);
+        double* t = &body.offset_tensors[6u * idx];
+        if (kind == IntraBodyTensor::point_dipole) {
+          dipole_tensor({di * h, dj * h, dk * h}, 0.0, t);
+        } else {
+          double n_tensor[6];
+          cube_demag_tensor(di, dj, dk, h, n_tensor);
+          for (int a = 0; a < 6; ++a) t[a] = -n_tensor[a] / (h * h * h);
+        }
       }
 }
 
@@ -53,7 +60,7 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     body.soft.alpha = sm->damping;
     body.soft.n = sm->moments_per_cell;
   }
-  if (body.responsive() && body.cell_count() > 1) build_offset_tensors(body);
+  if (body.responsive() && body.cell_count() > 1) build_offset_tensors(body, intra_tensor_);
 
   for (int c = 0; c < body.cell_count(); ++c) {
     cell_body_.push_back(body_count());

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "magnetics/cells.h"
+#include "magnetics/demag_tensor.h"
 #include "magnetics/llg.h"
 #include "magnetics/material.h"
 #include "magnetics/shape.h"
@@ -33,8 +34,9 @@ struct MagneticBody {
   Vec3 remanence;        // M_r for permanent bodies, body frame
   double recoil = 0.0;   // chi_r for permanent bodies
 
-  // Intra-body demagnetising tensors, computed once per body: the exact dipole
-  // tensor T(h * d) for every lattice offset d, six components each, body frame.
+  // Intra-body interaction tensors, computed once per body: H = T(d) mu for
+  // every lattice offset d (six components, body frame). T = -N(d) / h^3 with
+  // N the cube-cube tensor, or the point dipole (magnetics/demag_tensor.h).
   std::vector<double> offset_tensors;
   std::array<int, 3> offset_extent{0, 0, 0};  // 2 n - 1 per axis
 
@@ -51,6 +53,10 @@ struct MagneticBody {
 
 class MagneticModel {
  public:
+  MagneticModel() = default;
+  explicit MagneticModel(IntraBodyTensor intra_tensor) : intra_tensor_(intra_tensor) {}
+  IntraBodyTensor intra_body_tensor() const { return intra_tensor_; }
+
   // Adds a body and returns its index. cell_size <= 0: one cell (spheres) or
   // one cell at the centre. Throws std::invalid_argument on a bad shape or material.
   int add_body(const std::string& name, const Shape& shape, const Material& material,
@@ -70,6 +76,7 @@ class MagneticModel {
   int responsive_cell_count() const { return responsive_cells_; }
 
  private:
+  IntraBodyTensor intra_tensor_ = IntraBodyTensor::cell_average;
   std::vector<MagneticBody> bodies_;
   std::vector<int> cell_body_;
   std::vector<int> moment_offset_;

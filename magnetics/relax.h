@@ -2,6 +2,8 @@
 // "Relaxation loop"; paper Algorithm 1), and the rest of a magnetic step.
 #pragma once
 
+#include <vector>
+
 #include "magnetics/backend.h"
 #include "magnetics/llg.h"
 #include "magnetics/model.h"
@@ -41,6 +43,7 @@ struct RelaxReport {
   bool converged = false;
   long llg_steps = 0;         // per-cell LLG steps, summed over cells
   long newton_steps = 0;      // per-cell Newton steps, summed over cells
+  std::vector<double> residual_history;  // the convergence measure after each iteration
 };
 
 // Relaxes the magnetization of every active responsive cell at the current
