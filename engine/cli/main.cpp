@@ -1,7 +1,59 @@
-// Placeholder until the command line lands (issue 2, item 4).
+// odemag: the command-line program (INTERFACE.md "Commands").
+//
+// Exit status: 0 done; 2 bad input or usage, with one line on stderr naming
+// the file and the offending key; 1 anything else. Commands build their whole
+// output in memory and write it at the end, so a failure leaves no partial output.
 #include <cstdio>
+#include <exception>
+#include <new>
+#include <string>
+#include <vector>
 
-int main() {
-  std::fprintf(stderr, "odemag: not implemented yet\n");
-  return 1;
+#include "engine/cli/cli.h"
+#include "engine/scene.h"
+
+namespace {
+
+using odemag::cli::one_line;
+
+int usage_error(const std::string& message) {
+  std::fprintf(stderr, "odemag: %s\n", one_line(message).c_str());
+  return 2;
+}
+
+int dispatch(const std::string& command, const std::vector<std::string>& args) {
+  if (command == "help" || command == "--help" || command == "-h") {
+    odemag::cli::write_stdout(odemag::cli::usage_text());
+    return 0;
+  }
+  if (command == "solve") return odemag::cli::run_solve(args);
+  if (command == "field") return odemag::cli::run_field(args);
+  // `run` (ODE simulation, frames and per-frame state) is added with the
+  // simulation engine; dispatch to it here.
+  if (command == "run") throw odemag::cli::UsageError("'run' is not available yet in this build");
+  throw odemag::cli::UsageError("unknown command '" + command + "' (commands: solve, field, run, help)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) return usage_error("missing command; usage: odemag solve|field|run|help ... (see odemag --help)");
+  const std::string command = argv[1];
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  try {
+    return dispatch(command, args);
+  } catch (const odemag::cli::UsageError& e) {
+    return usage_error(e.what());
+  } catch (const odemag::SceneError& e) {
+    return usage_error(e.what());
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "odemag: out of memory\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "odemag: %s\n", one_line(e.what()).c_str());
+    return 1;
+  } catch (...) {
+    std::fprintf(stderr, "odemag: unexpected failure\n");
+    return 1;
+  }
 }

@@ -1,0 +1,320 @@
+// The odemag program end to end: runs bin/odemag on example and malformed
+// scenes and checks its output, its stderr and its exit status.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "magnetics/constants.h"
+#include "magnetics/vec3.h"
+
+namespace odemag {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::string kOdemag = ODEMAG_BINARY_DIR "/bin/odemag";
+const std::string kExamples = ODEMAG_SOURCE_DIR "/examples/";
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+struct ProgramRun {
+  int status = -1;  // exit status
+  std::string out, err;
+};
+
+// A scratch directory per test, removed at the end.
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("odemag_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+
+  // Runs odemag with the (already quoted) arguments; stdin from `input`.
+  ProgramRun odemag(const std::string& args, const std::string& input = "") {
+    const fs::path in = write("stdin.txt", input), out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command = shell_quote(kOdemag) + " " + args + " <" + shell_quote(in) + " >" +
+                                shell_quote(out) + " 2>" + shell_quote(err);
+    const int raw = std::system(command.c_str());
+    ProgramRun r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = read_file(out);
+    r.err = read_file(err);
+    return r;
+  }
+
+  // A malformed scene must give exit 2, no output and one stderr line naming
+  // the file and the key.
+  void expect_rejected(const std::string& name, const std::string& text, const std::string& key) {
+    const fs::path scene = write(name, text);
+    const ProgramRun r = odemag("solve " + shell_quote(scene.string()));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.out, "");
+    const auto err = lines(r.err);
+    ASSERT_EQ(err.size(), 1u) << r.err;
+    EXPECT_EQ(err[0].rfind("odemag: " + scene.string() + ": " + key + ": ", 0), 0u) << r.err;
+  }
+
+  fs::path dir_;
+};
+
+// Checks the documented keys of `odemag solve` output against the scene's bodies.
+void expect_solve_output(const json& j, const std::vector<std::string>& names) {
+  ASSERT_TRUE(j.is_object());
+  ASSERT_TRUE(j.contains("bodies") && j["bodies"].is_array());
+  ASSERT_EQ(j["bodies"].size(), names.size());
+  for (size_t b = 0; b < names.size(); ++b) {
+    const json& body = j["bodies"][b];
+    EXPECT_EQ(body["name"], names[b]);
+    EXPECT_TRUE(body["cells"].is_number_integer());
+    for (const char* key : {"moment", "force", "torque"}) {
+      ASSERT_TRUE(body[key].is_array()) << key;
+      ASSERT_EQ(body[key].size(), 3u) << key;
+      for (const json& x : body[key]) EXPECT_TRUE(x.is_number()) << key;
+    }
+  }
+  EXPECT_TRUE(j["iterations"].is_number_integer());
+  EXPECT_TRUE(j["residual"].is_number());
+}
+
+Vec3 vec(const json& a) { return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()}; }
+
+TEST_F(Cli, SolveBarAndBall) {
+  const ProgramRun r = odemag("solve " + shell_quote(kExamples + "bar_and_ball.json") + " --backend cpu");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  expect_solve_output(j, {"bar", "ball"});
+  EXPECT_EQ(j["bodies"][0]["cells"], 625);  // 25 x 5 x 5 at h = 4 mm
+  EXPECT_EQ(j["bodies"][1]["cells"], 1);    // a sphere without its own cell_size
+  EXPECT_TRUE(j["converged"].get<bool>());
+  // The bar's moment is M V; the iron ball is pulled up towards the bar, and
+  // the bar down by the same force.
+  EXPECT_NEAR(vec(j["bodies"][0]["moment"]).z, 1e6 * 0.10 * 0.02 * 0.02, 1e-9);
+  const Vec3 f_bar = vec(j["bodies"][0]["force"]), f_ball = vec(j["bodies"][1]["force"]);
+  EXPECT_GT(vec(j["bodies"][1]["moment"]).z, 0.0);
+  EXPECT_GT(f_ball.z, 0.0);
+  EXPECT_LT(norm(f_bar + f_ball), 1e-9 * norm(f_ball));
+}
+
+TEST_F(Cli, SolveTwoMagnetsGivesTheDipoleForce) {
+  const ProgramRun r = odemag("solve " + shell_quote(kExamples + "two_magnets.json") + " --backend=cpu --threads 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  expect_solve_output(j, {"lower", "upper"});
+  // Coaxial point dipoles: |F| = 3 mu0 m^2 / (2 pi r^4), attracting.
+  const double m = 9e5 * 4.0 / 3.0 * kPi * std::pow(0.005, 3), r4 = std::pow(0.03, 4);
+  const double expected = 3.0 * kMu0 * m * m / (2.0 * kPi * r4);
+  EXPECT_NEAR(vec(j["bodies"][0]["moment"]).z, m, 1e-12 * m);
+  EXPECT_NEAR(vec(j["bodies"][0]["force"]).z, expected, 1e-9 * expected);
+  EXPECT_NEAR(vec(j["bodies"][1]["force"]).z, -expected, 1e-9 * expected);
+}
+
+TEST_F(Cli, SolveEveryExample) {
+  for (const auto& entry : fs::directory_iterator(kExamples)) {
+    if (entry.path().extension() != ".json") continue;
+    const ProgramRun r = odemag("solve " + shell_quote(entry.path().string()) + " --backend cpu");
+    ASSERT_EQ(r.status, 0) << entry.path() << ": " << r.err;
+    const json j = json::parse(r.out);
+    const json scene = json::parse(read_file(entry.path()));
+    std::vector<std::string> names;
+    for (const json& b : scene["bodies"]) names.push_back(b["name"]);
+    expect_solve_output(j, names);
+  }
+}
+
+TEST_F(Cli, SolveReportsAbsentAndInertBodiesWithZeros) {
+  const ProgramRun r = odemag("solve " + shell_quote(kExamples + "drop_on_magnet.json") + " --backend cpu");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json j = json::parse(r.out);
+  const json& table = j["bodies"][0];
+  EXPECT_EQ(table["cells"], 0);
+  EXPECT_EQ(norm(vec(table["force"])), 0.0);
+  const json& absent = j["bodies"][3];
+  EXPECT_EQ(absent["name"], "ball_2");
+  EXPECT_FALSE(absent["present"].get<bool>());
+  EXPECT_EQ(norm(vec(absent["moment"])), 0.0);
+  EXPECT_EQ(norm(vec(absent["force"])), 0.0);
+}
+
+TEST_F(Cli, FieldPrintsHeaderAndOneRowPerPoint) {
+  const ProgramRun r = odemag("field " + shell_quote(kExamples + "bar_and_ball.json") + " --points " +
+                       shell_quote(kExamples + "points_line.csv") + " --backend cpu");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto out = lines(r.out);
+  ASSERT_EQ(out.size(), 6u);
+  EXPECT_EQ(out[0], "x,y,z,Bx,By,Bz,Hx,Hy,Hz");
+  for (size_t i = 1; i < out.size(); ++i) {
+    std::istringstream row(out[i]);
+    std::vector<double> values;
+    for (std::string cell; std::getline(row, cell, ',');) values.push_back(std::stod(cell));
+    ASSERT_EQ(values.size(), 9u);
+    EXPECT_GT(values[5], 0.0);  // above a magnet magnetized along +z: B_z > 0
+    EXPECT_NEAR(values[5], kMu0 * values[8], 1e-9 * std::abs(values[5]));  // outside: B = mu0 H
+  }
+}
+
+// A single-cell sphere magnet is a point dipole: B = mu0/(4 pi) (3 (m.r) r / r^5 - m / r^3).
+TEST_F(Cli, FieldOfOneCellSphereMagnetIsTheExactDipoleField) {
+  const double M = 8e5, R = 0.005;
+  const Vec3 centre{0.01, -0.02, 0.03};
+  const fs::path scene = write("dipole.json", R"({
+    "materials": {"nd": {"type": "permanent", "magnetization": [0, 0, 8e5]}},
+    "bodies": [{"name": "magnet", "shape": {"sphere": 0.005}, "material": "nd",
+                "position": [0.01, -0.02, 0.03]}]})");
+  const std::vector<Vec3> points = {centre + Vec3{0, 0, 0.05}, centre + Vec3{0, 0, -0.2},
+                                    centre + Vec3{0.03, 0.02, 0.04}, centre + Vec3{0.1, 0, 0}};
+  std::string csv = "x,y,z\n";
+  char line[200];
+  for (const Vec3& p : points) {
+    std::snprintf(line, sizeof line, "%.17g,%.17g,%.17g\n", p.x, p.y, p.z);
+    csv += line;
+  }
+  // Points from standard input.
+  const ProgramRun r = odemag("field " + shell_quote(scene.string()) + " --points - --backend cpu", csv);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto out = lines(r.out);
+  ASSERT_EQ(out.size(), points.size() + 1);
+  const Vec3 m{0, 0, M * 4.0 / 3.0 * kPi * R * R * R};
+  for (size_t i = 0; i < points.size(); ++i) {
+    std::istringstream row(out[i + 1]);
+    std::vector<double> v;
+    for (std::string cell; std::getline(row, cell, ',');) v.push_back(std::stod(cell));
+    ASSERT_EQ(v.size(), 9u);
+    const Vec3 d = points[i] - centre;
+    const double dist = norm(d);
+    const Vec3 B = (kMu0 / (4.0 * kPi)) *
+                   ((3.0 * dot(m, d) / std::pow(dist, 5)) * d - (1.0 / std::pow(dist, 3)) * m);
+    const Vec3 got{v[3], v[4], v[5]}, H{v[6], v[7], v[8]};
+    EXPECT_LT(norm(got - B), 1e-9 * norm(B)) << out[i + 1];
+    EXPECT_LT(norm(kMu0 * H - B), 1e-9 * norm(B)) << out[i + 1];
+  }
+  // On the axis at distance r: B_z = mu0 2 m / (4 pi r^3).
+  std::istringstream first(out[1]);
+  std::vector<double> v;
+  for (std::string cell; std::getline(first, cell, ',');) v.push_back(std::stod(cell));
+  const double axial = kMu0 * 2.0 * m.z / (4.0 * kPi * std::pow(0.05, 3));
+  EXPECT_NEAR(v[5], axial, 1e-9 * axial);
+}
+
+TEST_F(Cli, FieldRejectsMalformedPointsLine) {
+  const fs::path points = write("points.csv", "x,y,z\n0,0,0.2\n0,zero,0.3\n");
+  const ProgramRun r = odemag("field " + shell_quote(kExamples + "two_magnets.json") + " --points " +
+                       shell_quote(points.string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "");
+  const auto err = lines(r.err);
+  ASSERT_EQ(err.size(), 1u) << r.err;
+  EXPECT_EQ(err[0].rfind("odemag: " + points.string() + ": line 3: ", 0), 0u) << r.err;
+}
+
+TEST_F(Cli, FieldNeedsPoints) {
+  const ProgramRun r = odemag("field " + shell_quote(kExamples + "two_magnets.json"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(lines(r.err).size(), 1u);
+}
+
+TEST_F(Cli, MalformedScenesExitTwoNamingFileAndKey) {
+  const std::string materials = R"("materials": {"m": {"type": "permanent", "magnetization": [0, 0, 1e6]}})";
+  expect_rejected("unknown_key.json", "{" + materials + R"(, "bodies": [
+      {"name": "a", "shape": {"sphere": 0.01}, "material": "m", "colour": [1, 0, 0]}]})",
+                  "bodies[0].colour");
+  expect_rejected("negative_radius.json", "{" + materials + R"(, "bodies": [
+      {"name": "a", "shape": {"sphere": -0.01}, "material": "m"}]})",
+                  "bodies[0].shape.sphere");
+  expect_rejected("unknown_material.json", "{" + materials + R"(, "bodies": [
+      {"name": "a", "shape": {"sphere": 0.01}, "material": "iron"}]})",
+                  "bodies[0].material");
+  expect_rejected("overflow.json", "{" + materials + R"(, "gravity": [0, 0, -1e999], "bodies": [
+      {"name": "a", "shape": {"sphere": 0.01}, "material": "m"}]})",
+                  "gravity[2]");
+  expect_rejected("bad_backend.json", "{" + materials + R"(, "solver": {"backend": "gpu"}, "bodies": [
+      {"name": "a", "shape": {"sphere": 0.01}, "material": "m"}]})",
+                  "solver.backend");
+}
+
+TEST_F(Cli, JsonSyntaxErrorExitsTwoWithLine) {
+  const fs::path scene = write("nan.json", "{\n  \"gravity\": [0, 0, NaN]\n}\n");
+  const ProgramRun r = odemag("solve " + shell_quote(scene.string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "");
+  const auto err = lines(r.err);
+  ASSERT_EQ(err.size(), 1u) << r.err;
+  EXPECT_EQ(err[0].rfind("odemag: " + scene.string() + ": ", 0), 0u) << r.err;
+  EXPECT_NE(err[0].find("line 2"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, MissingSceneFileExitsTwo) {
+  const std::string missing = (dir_ / "no_such_scene.json").string();
+  const ProgramRun r = odemag("solve " + shell_quote(missing));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "");
+  const auto err = lines(r.err);
+  ASSERT_EQ(err.size(), 1u) << r.err;
+  EXPECT_NE(err[0].find(missing), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, UsageErrorsExitTwo) {
+  for (const std::string args : {"", "frobnicate", "solve", "solve a.json b.json", "solve --bogus 1 x.json",
+                                 "field", "run x.json"}) {
+    const ProgramRun r = odemag(args);
+    EXPECT_EQ(r.status, 2) << "odemag " << args;
+    EXPECT_EQ(r.out, "") << "odemag " << args;
+    EXPECT_EQ(lines(r.err).size(), 1u) << "odemag " << args << ": " << r.err;
+  }
+  const ProgramRun bad_backend = odemag("solve " + shell_quote(kExamples + "two_magnets.json") + " --backend gpu");
+  EXPECT_EQ(bad_backend.status, 2);
+}
+
+TEST_F(Cli, HelpExitsZero) {
+  for (const char* args : {"--help", "help"}) {
+    const ProgramRun r = odemag(args);
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("odemag"), std::string::npos);
+    EXPECT_NE(r.out.find("solve"), std::string::npos);
+    EXPECT_NE(r.out.find("field"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace odemag
