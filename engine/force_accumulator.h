@@ -1,0 +1,18 @@
+// Things that add forces and torques to ODE bodies before each rigid step
+// (MODEL.md "One rigid step", 4: dBodyAddForce / dBodyAddTorque).
+#pragma once
+
+namespace odemag {
+
+class ForceAccumulator {
+ public:
+  virtual ~ForceAccumulator() = default;
+  // Recomputes the forces for the rigid step starting at `time` (s) of length dt.
+  virtual void update(double time, double dt) = 0;
+  // Adds the current forces and torques to the ODE bodies. ODE clears its
+  // force accumulators after every dWorldQuickStep, so this runs before each
+  // (sub)step; the forces stay those computed by the last update().
+  virtual void add_forces() = 0;
+};
+
+}  // namespace odemag

@@ -1,0 +1,178 @@
+#include "engine/rigid_world.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <variant>
+
+#include "engine/magnetic_forces.h"
+
+namespace odemag {
+
+namespace {
+
+// dInitODE2 once per process, dCloseODE at exit.
+struct OdeLibrary {
+  OdeLibrary() { dInitODE2(0); }
+  ~OdeLibrary() { dCloseODE(); }
+};
+
+void ensure_ode_initialised() { static OdeLibrary library; }
+
+constexpr int kMaxContacts = 8;
+
+// Collision skin: each body's collision geometry is larger than its shape by
+// this fraction of its smallest half extent, and contact depths are reduced
+// by the skins. Two bodies closer than their skins therefore touch through a
+// contact that stops further approach without pushing them apart: a body held
+// against a magnet stays in contact even when it lifts off by a hair, instead
+// of falling freely into the magnet during the next substep (docs/simulation.md).
+constexpr double kSkinFraction = 0.02;
+
+}  // namespace
+
+RigidWorld::RigidWorld(const SceneDescription& scene) : contact_(scene.simulation.contact) {
+  ensure_ode_initialised();
+  world_ = dWorldCreate();
+  space_ = dHashSpaceCreate(nullptr);
+  contacts_ = dJointGroupCreate(0);
+  dWorldSetGravity(world_, scene.gravity.x, scene.gravity.y, scene.gravity.z);
+  dWorldSetQuickStepNumIterations(world_, scene.simulation.solver_iterations);
+  dWorldSetERP(world_, scene.simulation.contact.erp);
+  dWorldSetCFM(world_, scene.simulation.contact.softness);
+  // Penetration is resolved at a bounded speed, so strong magnetic pulls
+  // into a contact do not make bodies jump apart (see also the skin below).
+  dWorldSetContactMaxCorrectingVel(world_, 0.1);
+  dWorldSetLinearDamping(world_, scene.simulation.linear_damping);
+  dWorldSetAngularDamping(world_, scene.simulation.angular_damping);
+  if (scene.simulation.ground)
+    ground_ = dCreatePlane(space_, 0, 0, 1, scene.simulation.ground_height);
+
+  for (const BodyDescription& d : scene.bodies) {
+    Body b;
+    b.body = dBodyCreate(world_);
+    const Vec3 half = shape_half_extents(d.shape);
+    b.skin = kSkinFraction * std::min({half.x, half.y, half.z});
+    const double skin = b.skin;
+    dMass m;
+    dMassSetZero(&m);
+    if (const auto* s = std::get_if<Sphere>(&d.shape)) {
+      dMassSetSphere(&m, d.density, s->radius);
+      b.geom = dCreateSphere(space_, s->radius + skin);
+    } else if (const auto* x = std::get_if<Box>(&d.shape)) {
+      dMassSetBox(&m, d.density, x->size.x, x->size.y, x->size.z);
+      b.geom = dCreateBox(space_, x->size.x + 2 * skin, x->size.y + 2 * skin, x->size.z + 2 * skin);
+    } else if (const auto* c = std::get_if<Cylinder>(&d.shape)) {
+      dMassSetCylinder(&m, d.density, 3, c->radius, c->length);
+      b.geom = dCreateCylinder(space_, c->radius + skin, c->length + 2 * skin);
+    }
+    dBodySetMass(b.body, &m);
+    b.mass = m.mass;
+    dGeomSetBody(b.geom, b.body);
+    dBodySetData(b.body, reinterpret_cast<void*>(static_cast<intptr_t>(bodies_.size())));
+    dBodySetPosition(b.body, d.position.x, d.position.y, d.position.z);
+    const dQuaternion q = {d.orientation.w, d.orientation.x, d.orientation.y, d.orientation.z};
+    dBodySetQuaternion(b.body, q);
+    dBodySetLinearVel(b.body, d.velocity.x, d.velocity.y, d.velocity.z);
+    dBodySetAngularVel(b.body, d.angular_velocity.x, d.angular_velocity.y, d.angular_velocity.z);
+    if (d.fixed) {
+      dBodySetKinematic(b.body);
+      b.kinematic = true;
+    }
+    bodies_.push_back(b);
+    if (!d.present) set_enabled(body_count() - 1, false);
+  }
+}
+
+RigidWorld::~RigidWorld() {
+  dJointGroupDestroy(contacts_);
+  dSpaceDestroy(space_);  // destroys the geoms it holds
+  dWorldDestroy(world_);  // destroys the bodies
+}
+
+double RigidWorld::skin_of(dGeomID geom) const {
+  dBodyID body = dGeomGetBody(geom);
+  return body ? bodies_[index_of(body)].skin : 0.0;
+}
+
+int RigidWorld::index_of(dBodyID body) const {
+  return static_cast<int>(reinterpret_cast<intptr_t>(dBodyGetData(body)));
+}
+
+void RigidWorld::set_enabled(int i, bool enabled) {
+  Body& b = bodies_[i];
+  b.enabled = enabled;
+  if (enabled) {
+    dBodyEnable(b.body);
+    dGeomEnable(b.geom);
+  } else {
+    dBodyDisable(b.body);
+    dGeomDisable(b.geom);
+  }
+}
+
+void RigidWorld::set_kinematic_state(int i, const BodyPose& pose, const Vec3& v, const Vec3& w) {
+  dBodyID body = bodies_[i].body;
+  dBodySetPosition(body, pose.position.x, pose.position.y, pose.position.z);
+  dMatrix3 R;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R[4 * r + c] = pose.rotation.m[r][c];
+    R[4 * r + 3] = 0.0;
+  }
+  dBodySetRotation(body, R);
+  dBodySetLinearVel(body, v.x, v.y, v.z);
+  dBodySetAngularVel(body, w.x, w.y, w.z);
+}
+
+void RigidWorld::update_forces(double time, double dt) {
+  for (ForceAccumulator* a : accumulators_) a->update(time, dt);
+}
+
+void RigidWorld::integrate(double h) {
+  for (ForceAccumulator* a : accumulators_) a->add_forces();
+  for (Body& b : bodies_) b.in_contact = false;
+  dSpaceCollide(space_, this, &RigidWorld::near_callback);
+  dWorldQuickStep(world_, h);
+  dJointGroupEmpty(contacts_);
+}
+
+void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
+  auto* self = static_cast<RigidWorld*>(data);
+  dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
+  const bool a_moves = ba && !dBodyIsKinematic(ba);
+  const bool b_moves = bb && !dBodyIsKinematic(bb);
+  if (!a_moves && !b_moves) return;  // nothing to resolve between immovable things
+  dContact contact[kMaxContacts];
+  const int n = dCollide(a, b, kMaxContacts, &contact[0].geom, sizeof(dContact));
+  if (n > 0) {
+    for (dBodyID body : {ba, bb})
+      if (body) self->bodies_[self->index_of(body)].in_contact = true;
+  }
+  const double skins = self->skin_of(a) + self->skin_of(b);
+  for (int i = 0; i < n; ++i) {
+    contact[i].geom.depth = std::max(0.0, contact[i].geom.depth - skins);
+    dSurfaceParameters& s = contact[i].surface;
+    s.mode = dContactBounce | dContactSoftCFM | dContactSoftERP | dContactApprox1 | dContactRolling;
+    s.rho = s.rho2 = s.rhoN = self->contact_.rolling_friction;
+    s.mu = self->contact_.friction;
+    s.bounce = self->contact_.restitution;
+    s.bounce_vel = 0.01;
+    s.soft_cfm = self->contact_.softness;
+    s.soft_erp = self->contact_.erp;
+    dJointID j = dJointCreateContact(self->world_, self->contacts_, &contact[i]);
+    dJointAttach(j, ba, bb);
+  }
+}
+
+BodyPose RigidWorld::pose(int i) const { return ode_pose(bodies_[i].body); }
+
+Vec3 RigidWorld::velocity(int i) const {
+  const dReal* v = dBodyGetLinearVel(bodies_[i].body);
+  return {v[0], v[1], v[2]};
+}
+
+Vec3 RigidWorld::angular_velocity(int i) const {
+  const dReal* w = dBodyGetAngularVel(bodies_[i].body);
+  return {w[0], w[1], w[2]};
+}
+
+}  // namespace odemag

@@ -1,0 +1,79 @@
+// The ODE side of a scene: world, collision space, contact joints, one ODE
+// body and geom per scene body, a ground plane (MODEL.md "One rigid step", 5).
+#pragma once
+
+#include <ode/ode.h>
+
+#include <vector>
+
+#include "engine/force_accumulator.h"
+#include "engine/scene.h"
+#include "magnetics/state.h"
+
+namespace odemag {
+
+class RigidWorld {
+ public:
+  // Bodies are created in scene order; "fixed" bodies are kinematic (they
+  // move only by keyframes); bodies with present = false start disabled.
+  explicit RigidWorld(const SceneDescription& scene);
+  ~RigidWorld();
+  RigidWorld(const RigidWorld&) = delete;
+  RigidWorld& operator=(const RigidWorld&) = delete;
+
+  dWorldID world() const { return world_; }
+  dSpaceID space() const { return space_; }
+  int body_count() const { return static_cast<int>(bodies_.size()); }
+  dBodyID body(int i) const { return bodies_[i].body; }
+  bool kinematic(int i) const { return bodies_[i].kinematic; }
+  double mass(int i) const { return bodies_[i].mass; }
+
+  // Disabled bodies neither move nor collide (removed from the scene).
+  void set_enabled(int i, bool enabled);
+  bool enabled(int i) const { return bodies_[i].enabled; }
+
+  // Places a kinematic body and gives it the velocities it moves with during
+  // the next step (so contacts see the motion).
+  void set_kinematic_state(int i, const BodyPose& pose, const Vec3& velocity, const Vec3& angular_velocity);
+
+  // Accumulators, in order (not owned).
+  void add_accumulator(ForceAccumulator* accumulator) { accumulators_.push_back(accumulator); }
+
+  // The two halves of a rigid step, timed separately by the simulation:
+  // update_forces() recomputes every accumulator's forces; integrate(h) adds
+  // them to the bodies, collides, runs dWorldQuickStep(h) and empties the
+  // contacts. A step may integrate several substeps with one update.
+  void update_forces(double time, double dt);
+  void integrate(double h);
+
+  // Whether the body touched something in the last integrate().
+  bool in_contact(int i) const { return bodies_[i].in_contact; }
+
+  BodyPose pose(int i) const;
+  Vec3 velocity(int i) const;
+  Vec3 angular_velocity(int i) const;
+
+ private:
+  struct Body {
+    dBodyID body = nullptr;
+    dGeomID geom = nullptr;
+    bool kinematic = false;
+    bool enabled = true;
+    double mass = 0.0;
+    bool in_contact = false;
+    double skin = 0.0;  // collision geometry enlarged by this much, m
+  };
+  int index_of(dBodyID body) const;
+  static void near_callback(void* data, dGeomID a, dGeomID b);
+  double skin_of(dGeomID geom) const;
+
+  dWorldID world_ = nullptr;
+  dSpaceID space_ = nullptr;
+  dJointGroupID contacts_ = nullptr;
+  dGeomID ground_ = nullptr;
+  std::vector<Body> bodies_;
+  std::vector<ForceAccumulator*> accumulators_;
+  ContactSettings contact_;
+};
+
+}  // namespace odemag

@@ -1,0 +1,224 @@
+#include "engine/simulation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "engine/magnetic_scene.h"
+
+namespace odemag {
+
+namespace {
+
+double elapsed_ms(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
+}
+
+Quaternion slerp(Quaternion a, Quaternion b, double u) {
+  double d = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
+  if (d < 0.0) {  // shorter arc
+    b = {-b.w, -b.x, -b.y, -b.z};
+    d = -d;
+  }
+  double wa = 1.0 - u, wb = u;
+  if (d < 0.9995) {
+    const double theta = std::acos(d), s = std::sin(theta);
+    wa = std::sin((1.0 - u) * theta) / s;
+    wb = std::sin(u * theta) / s;
+  }
+  return {wa * a.w + wb * b.w, wa * a.x + wb * b.x, wa * a.y + wb * b.y, wa * a.z + wb * b.z};
+}
+
+// Angular velocity that turns rotation A into rotation B in time dt.
+Vec3 angular_velocity_between(const Mat3& A, const Mat3& B, double dt) {
+  const Mat3 R = B * A.transposed();  // world-frame increment
+  const double c = std::clamp((R.m[0][0] + R.m[1][1] + R.m[2][2] - 1.0) / 2.0, -1.0, 1.0);
+  const double angle = std::acos(c);
+  if (angle < 1e-12) return {};
+  const Vec3 axis{R.m[2][1] - R.m[1][2], R.m[0][2] - R.m[2][0], R.m[1][0] - R.m[0][1]};
+  return (angle / (dt * norm(axis))) * axis;
+}
+
+}  // namespace
+
+BodyPose keyframe_pose(const std::vector<Keyframe>& keys, double t) {
+  auto pose_of = [](const Vec3& p, const Quaternion& q) {
+    BodyPose pose;
+    pose.position = p;
+    pose.rotation = rotation_from_quaternion(q.w, q.x, q.y, q.z);
+    return pose;
+  };
+  if (t <= keys.front().time) return pose_of(keys.front().position, keys.front().orientation);
+  if (t >= keys.back().time) return pose_of(keys.back().position, keys.back().orientation);
+  size_t i = 1;
+  while (keys[i].time < t) ++i;
+  const Keyframe& a = keys[i - 1];
+  const Keyframe& b = keys[i];
+  const double u = (t - a.time) / (b.time - a.time);
+  return pose_of(a.position + u * (b.position - a.position), slerp(a.orientation, b.orientation, u));
+}
+
+Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBackend> backend)
+    : scene_(scene) {
+  world_ = std::make_unique<RigidWorld>(scene_);
+  magnetics_ = std::make_unique<MagneticForces>(
+      scene_.solver.relax, backend ? std::move(backend) : make_cpu_backend(scene_.solver.threads),
+      scene_.seed);
+  for (size_t b = 0; b < scene_.bodies.size(); ++b) {
+    const BodyDescription& d = scene_.bodies[b];
+    const Material& material = scene_.materials.at(d.material);
+    try {
+      magnetics_->attach(world_->body(static_cast<int>(b)), d.shape, material,
+                         d.cell_size.value_or(scene_.cell_size), d.name);
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(scene_.file, "bodies[" + std::to_string(b) + "]", e.what());
+    }
+    magnetics_->set_active(static_cast<int>(b), d.present);
+  }
+  magnetics_->set_external_field(scene_.external_field);
+  world_->add_accumulator(magnetics_.get());
+  for (const BodyDescription& d : scene_.bodies) {
+    const Vec3 half = shape_half_extents(d.shape);
+    body_size_.push_back(std::min({half.x, half.y, half.z}));
+  }
+  event_state_.assign(scene_.timeline.size(), kPending);
+  ramp_start_scale_.assign(scene_.timeline.size(), 1.0);
+  ramp_start_field_.assign(scene_.timeline.size(), Vec3{});
+}
+
+void Simulation::apply_timeline(double dt) {
+  for (size_t e = 0; e < scene_.timeline.size(); ++e) {
+    const TimelineEvent& ev = scene_.timeline[e];
+    const int body = ev.body.empty() ? -1 : scene_.find_body(ev.body);
+    if (ev.kind == TimelineEvent::Kind::keyframes) {
+      // Scripted motion: place the body where the track says and give it the
+      // velocity that takes it to the next step's pose.
+      const BodyPose now = keyframe_pose(ev.keys, time_);
+      const BodyPose next = keyframe_pose(ev.keys, time_ + dt);
+      world_->set_kinematic_state(body, now, (1.0 / dt) * (next.position - now.position),
+                                  angular_velocity_between(now.rotation, next.rotation, dt));
+      continue;
+    }
+    if (time_ + 0.5 * dt < ev.time || event_state_[e] == kDone) continue;  // not due, or over
+    const bool first = event_state_[e] == kPending;
+    event_state_[e] = kRunning;
+    const double span = ev.end_time - ev.time;
+    const double u = span > 0.0 ? std::clamp((time_ - ev.time) / span, 0.0, 1.0) : 1.0;
+    if (u >= 1.0) event_state_[e] = kDone;  // this application is the last
+    switch (ev.kind) {
+      case TimelineEvent::Kind::add_body:
+        world_->set_enabled(body, true);
+        magnetics_->set_active(body, true);
+        break;
+      case TimelineEvent::Kind::remove_body:
+        world_->set_enabled(body, false);
+        magnetics_->set_active(body, false);
+        break;
+      case TimelineEvent::Kind::mutual_induction:
+        magnetics_->options().mutual_induction = ev.enabled;
+        break;
+      case TimelineEvent::Kind::scale_magnetization:
+        if (first) ramp_start_scale_[e] = magnetics_->magnetization_scale(body);
+        magnetics_->set_magnetization_scale(body, ramp_start_scale_[e] + u * (ev.value - ramp_start_scale_[e]));
+        break;
+      case TimelineEvent::Kind::external_field:
+        if (first) ramp_start_field_[e] = magnetics_->external_field();
+        magnetics_->set_external_field(ramp_start_field_[e] + u * (ev.field - ramp_start_field_[e]));
+        break;
+      case TimelineEvent::Kind::keyframes:
+        break;
+    }
+  }
+}
+
+int Simulation::substeps_needed(double dt) const {
+  const int cap = std::max(1, scene_.simulation.max_substeps);
+  double worst = 0.0;
+  for (int b = 0; b < world_->body_count(); ++b) {
+    if (world_->kinematic(b) || !world_->enabled(b)) continue;
+    const double f = norm(magnetics_->force(b)), m = world_->mass(b), size = body_size_[b];
+    // Collision: travel per substep, at the current velocity and the full
+    // acceleration of gravity and magnetic force, at most a tenth of the
+    // body's size; three tenths for a body that was in contact, which the
+    // contact most likely still holds (it may have lifted off by a hair, so
+    // its acceleration still counts).
+    const double a = f / m + norm(scene_.gravity);
+    const double allowed = (world_->in_contact(b) ? 0.3 : 0.1) * size;
+    worst = std::max(worst, (norm(world_->velocity(b)) * dt + 0.5 * a * dt * dt) / allowed);
+    // Time scale of the magnetic force: it varies over distances of the
+    // body's size, so it oscillates a body about an equilibrium at
+    // omega^2 ~ |F| / (m size); the explicit update needs omega h <= limit.
+    worst = std::max(worst, dt * std::sqrt(f / (m * size)) / scene_.simulation.stiffness_limit);
+  }
+  if (!std::isfinite(worst)) return cap;
+  return std::clamp(static_cast<int>(std::ceil(worst)), 1, cap);
+}
+
+void Simulation::step() {
+  const double dt = scene_.simulation.time_step;
+  apply_timeline(dt);
+  StepRecord record;
+  record.time = time_;
+  record.magnetic_solves = 0;
+  auto update_forces = [&](double t, double h) {
+    // T_m: relaxation, forces and torques.
+    const auto t0 = std::chrono::steady_clock::now();
+    world_->update_forces(t, h);
+    record.magnetic_ms += elapsed_ms(t0);
+    const RelaxReport& report = magnetics_->last_report();
+    record.iterations += report.iterations;
+    record.converged = record.converged && report.converged;
+    record.residual = std::max(record.residual, report.residual);
+    ++record.magnetic_solves;
+  };
+  update_forces(time_, dt);
+  // Substeps, each with its own forces: holding one step's forces over
+  // several substeps is not symplectic and makes resting contacts unstable
+  // (docs/simulation.md "Substeps").
+  record.substeps = substeps_needed(dt);
+  const double h = dt / record.substeps;
+  for (int k = 0; k < record.substeps; ++k) {
+    if (k > 0) update_forces(time_ + k * h, h);
+    // T_r: collision, dWorldQuickStep, contacts.
+    const auto t0 = std::chrono::steady_clock::now();
+    world_->integrate(h);
+    record.rigid_ms += elapsed_ms(t0);
+  }
+  records_.push_back(record);
+  time_ += dt;
+  ++steps_;
+  evaluate_outcomes(false);
+}
+
+void Simulation::advance_to(double t) {
+  const double dt = scene_.simulation.time_step;
+  while (time_ + 0.5 * dt < t) step();
+}
+
+void Simulation::finish() { evaluate_outcomes(true); }
+
+void Simulation::evaluate_outcomes(bool end) {
+  for (const OutcomeDescription& o : scene_.outcomes) {
+    if (outcomes_.count(o.name)) continue;
+    const bool due = o.time < 0.0 ? end : time_ + 0.5 * scene_.simulation.time_step >= o.time;
+    if (due) outcomes_[o.name] = count_above(o.prefix, o.height);
+  }
+}
+
+int Simulation::count_above(const std::string& prefix, double height) const {
+  int count = 0;
+  for (int b = 0; b < world_->body_count(); ++b) {
+    if (!world_->enabled(b) || scene_.bodies[b].name.rfind(prefix, 0) != 0) continue;
+    if (world_->pose(b).position.z > height) ++count;
+  }
+  return count;
+}
+
+bool Simulation::finite_state(int b) const {
+  const BodyPose p = world_->pose(b);
+  return is_finite(p.position) && is_finite(world_->velocity(b)) &&
+         is_finite(world_->angular_velocity(b)) && is_finite(magnetics_->force(b)) &&
+         is_finite(magnetics_->torque(b)) && is_finite(magnetics_->moment(b));
+}
+
+}  // namespace odemag
