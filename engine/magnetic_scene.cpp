@@ -23,7 +23,7 @@ MagneticScene build_magnetic_scene(const SceneDescription& scene) {
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "].material",
                        "unknown material \"" + body.material + "\"");
     try {
-      ms.model.add_body(body.name, body.shape, material->second, body.cell_size.value_or(scene.cell_size));
+      ms.model.add_body(body.name, body.shape, material->second, scene.body_cell_size(static_cast<int>(b)));
     } catch (const std::invalid_argument& e) {
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
     }

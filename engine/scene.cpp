@@ -30,6 +30,13 @@ int SceneDescription::find_body(const std::string& name) const {
   return -1;
 }
 
+double lattice_spacing(const BodyDescription& body, double scene_cell_size) {
+  if (body.cell_size) return *body.cell_size;
+  return std::holds_alternative<Sphere>(body.shape) ? 0.0 : scene_cell_size;
+}
+
+double SceneDescription::body_cell_size(int b) const { return lattice_spacing(bodies[b], cell_size); }
+
 namespace {
 
 using json = nlohmann::json;
@@ -388,11 +395,9 @@ BodyDescription read_body(const SceneReader& r, const json& v, const std::string
   r.optional(v, "present", path, [&](const json& x, const std::string& p) { body.present = r.boolean(x, p); });
   r.optional(v, "color", path, [&](const json& x, const std::string& p) { body.color = r.color(x, p); });
 
-  // INTERFACE.md: a sphere without a cell_size of its own is one cell.
-  if (!body.cell_size && std::holds_alternative<Sphere>(body.shape)) body.cell_size = 0.0;
 
   // The lattice must stay a sensible size.
-  const double h = body.cell_size.value_or(scene.cell_size);
+  const double h = lattice_spacing(body, scene.cell_size);
   if (h > 0.0 && !is_inert(scene.materials.at(body.material))) {
     const Vec3 half = shape_half_extents(body.shape);
     double points = 1.0;

@@ -153,7 +153,14 @@ struct SceneDescription {
   std::vector<OutcomeDescription> outcomes;
 
   int find_body(const std::string& name) const;  // -1 when absent
+
+  // Lattice spacing of body b: lattice_spacing(bodies[b], cell_size).
+  double body_cell_size(int b) const;
 };
+
+// Lattice spacing of a body (INTERFACE.md): its own cell_size if given;
+// otherwise one cell for a sphere and the scene's cell_size for the rest.
+double lattice_spacing(const BodyDescription& body, double scene_cell_size);
 
 // Reads and validates a scene file. Throws SceneError (bad content, unknown
 // key, wrong type, NaN, negative size, missing key, unknown material, ...).

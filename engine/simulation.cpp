@@ -69,7 +69,7 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
     const Material& material = scene_.materials.at(d.material);
     try {
       magnetics_->attach(world_->body(static_cast<int>(b)), d.shape, material,
-                         d.cell_size.value_or(scene_.cell_size), d.name);
+                         scene_.body_cell_size(static_cast<int>(b)), d.name);
     } catch (const std::invalid_argument& e) {
       throw SceneError(scene_.file, "bodies[" + std::to_string(b) + "]", e.what());
     }

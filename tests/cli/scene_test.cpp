@@ -96,9 +96,11 @@ TEST(SceneParser, InterfaceExample) {
   EXPECT_EQ(ball.density, 7870.0);
   EXPECT_FALSE(ball.fixed);
   EXPECT_TRUE(ball.present);
-  // INTERFACE.md: a sphere without a cell_size of its own is one cell.
-  ASSERT_TRUE(ball.cell_size.has_value());
-  EXPECT_EQ(*ball.cell_size, 0.0);
+  // INTERFACE.md: a sphere without a cell_size of its own is one cell; the
+  // bar inherits the scene's spacing.
+  EXPECT_FALSE(ball.cell_size.has_value());
+  EXPECT_EQ(s.body_cell_size(1), 0.0);
+  EXPECT_EQ(s.body_cell_size(0), 0.004);
   EXPECT_EQ(s.find_body("ball"), 1);
   EXPECT_EQ(s.find_body("nothing"), -1);
   // Defaults of what the example leaves out.
