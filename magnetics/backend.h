@@ -50,7 +50,8 @@ class MagneticBackend {
   // state.force and state.torque of every body from the magnetizations.
   virtual void forces(const MagneticModel& model, MagneticState& state) = 0;
 
-  // H (A/m) at world points from H_E and every active cell.
+  // H (A/m) at world points from H_E and every active cell, each cell the
+  // uniformly magnetized solid it stands for (magnetics/field_probe.h).
   virtual void field_at_points(const MagneticModel& model, const MagneticState& state,
                                const std::vector<Vec3>& points, std::vector<Vec3>& H) = 0;
 };

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "magnetics/backend.h"
+#include "magnetics/field_probe.h"
 #include "magnetics/kernels.h"
 
 namespace odemag {
@@ -199,14 +200,15 @@ class CpuBackend final : public MagneticBackend {
 
   void field_at_points(const MagneticModel& model, const MagneticState& state,
                        const std::vector<Vec3>& points, std::vector<Vec3>& H) override {
-    all_.load_moments(model, state);
-    const int n = static_cast<int>(points.size());
+    const std::vector<ProbeCell> cells = probe_cells(model, state);
+    const int n = static_cast<int>(points.size()), m = static_cast<int>(cells.size());
     H.resize(n);
-#pragma omp parallel for schedule(static) num_threads(threads_) if (static_cast<long>(n) * all_.size() > kParallelPairs)
-    for (int p = 0; p < n; ++p)
-      // A point is a target of radius 0: the kernel is bounded inside each cell's sphere.
-      H[p] = state.external_field +
-             sum_field(all_, 0, all_.size(), points[p].x, points[p].y, points[p].z, 0.0, true);
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threads_) if (static_cast<long>(n) * m > kParallelPairs)
+    for (int p = 0; p < n; ++p) {
+      Vec3 h = state.external_field;
+      for (int c = 0; c < m; ++c) h += probe_cell_field(cells[c], points[p]);
+      H[p] = h;
+    }
   }
 
  private:

@@ -1,0 +1,113 @@
+// The field of one uniformly magnetized cell at an arbitrary point, for field
+// probes (`odemag field`, field lines): cubes for lattice cells, the body's own
+// box or sphere for single-cell bodies. The relaxation and the forces use the
+// dipole kernel (magnetics/kernels.h); outside a cell both agree up to
+// (size / distance)^4 for cubes and exactly for spheres.
+#pragma once
+
+#include "magnetics/constants.h"
+#include "magnetics/hd.h"
+#include "magnetics/kernels.h"
+#include "magnetics/vec3.h"
+
+namespace odemag {
+
+// H (A/m) at offset r from the centre of a uniformly magnetized sphere of
+// radius R and moment mu: the dipole field outside, -M/3 = -mu/(4 pi R^3) inside.
+ODEMAG_HD Vec3 uniform_sphere_field(const Vec3& r, double R, const Vec3& mu) {
+  if (squared_norm(r) >= R * R) return dipole_field(r, mu, 0.0);
+  return (-1.0 / (4.0 * kPi * R * R * R)) * mu;
+}
+
+// log(Z2 + R2) - log(Z1 + R1) at the same (X, Y): the difference that the
+// cuboid's off-diagonal terms need, written so that it stays finite on the
+// line of an edge beyond its end (Z + R = (X^2 + Y^2) / (R - Z) for Z < 0).
+ODEMAG_HD double log_pair(double X, double Y, double Z1, double Z2) {
+  const double rho2 = X * X + Y * Y;
+  const double R1 = sqrt(rho2 + Z1 * Z1), R2 = sqrt(rho2 + Z2 * Z2);
+  if (Z1 >= 0.0 && Z2 >= 0.0) return log((Z2 + R2) / (Z1 + R1));
+  if (Z1 < 0.0 && Z2 < 0.0) return log((R1 - Z1) / (R2 - Z2));
+  return log((Z2 >= 0.0 ? Z2 + R2 : rho2 / (R2 - Z2)) / (Z1 >= 0.0 ? Z1 + R1 : rho2 / (R1 - Z1)));
+}
+
+// atan(Y Z / (X R)), taken as 0 in the plane X = 0 (the mean of the two
+// sides: exact outside the face, the average of both sides on it).
+ODEMAG_HD double corner_angle(double X, double Y, double Z) {
+  if (X == 0.0) return 0.0;
+  return atan(Y * Z / (X * sqrt(X * X + Y * Y + Z * Z)));
+}
+
+// Demagnetising tensor N(p) of an axis-aligned cuboid of half extents
+// (a, b, c) centred at the origin: H(p) = -N(p) M. From the surface charges
+// sigma = M.n summed over the eight corners (x' = +-a, ...), sign s = sx sy sz:
+//   N_xx = -(1/4pi) sum s atan(Y Z / (X R)),  N_xy = (1/4pi) sum s log(Z + R),
+// with X = x - x', etc., and the other components by permutation.
+// N(0) = I/3 for a cube. Six components (xx, xy, xz, yy, yz, zz).
+ODEMAG_HD void cuboid_demag_tensor(const Vec3& p, const Vec3& half, double n[6]) {
+  const double k = 1.0 / (4.0 * kPi);
+  double xx = 0, yy = 0, zz = 0, xy = 0, xz = 0, yz = 0;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int l = 0; l < 2; ++l) {
+        const double sx = i ? 1.0 : -1.0, sy = j ? 1.0 : -1.0, sz = l ? 1.0 : -1.0;
+        const double X = p.x - sx * half.x, Y = p.y - sy * half.y, Z = p.z - sz * half.z;
+        const double s = sx * sy * sz;
+        xx -= s * corner_angle(X, Y, Z);
+        yy -= s * corner_angle(Y, X, Z);
+        zz -= s * corner_angle(Z, X, Y);
+      }
+  // Off-diagonal terms: the corner sums of s log(W + R) paired along W.
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) {
+      const double s1 = i ? 1.0 : -1.0, s2 = j ? 1.0 : -1.0, s = s1 * s2;
+      // xy: pairs along z, with X, Y at the corner.
+      xy += s * log_pair(p.x - s1 * half.x, p.y - s2 * half.y, p.z + half.z, p.z - half.z);
+      xz += s * log_pair(p.x - s1 * half.x, p.z - s2 * half.z, p.y + half.y, p.y - half.y);
+      yz += s * log_pair(p.y - s1 * half.y, p.z - s2 * half.z, p.x + half.x, p.x - half.x);
+    }
+  n[0] = k * xx;
+  n[1] = k * xy;
+  n[2] = k * xz;
+  n[3] = k * yy;
+  n[4] = k * yz;
+  n[5] = k * zz;
+}
+
+// H (A/m) at p (cuboid frame) of an axis-aligned cuboid with magnetization M.
+ODEMAG_HD Vec3 uniform_cuboid_field(const Vec3& p, const Vec3& half, const Vec3& M) {
+  double n[6];
+  cuboid_demag_tensor(p, half, n);
+  return -symmetric_times(n, M);
+}
+
+
+// One cell as a field source for probes.
+struct ProbeCell {
+  enum Kind : int { sphere = 0, cuboid = 1 };
+  Vec3 position;   // centre, world, m
+  Vec3 moment;     // mu = M V, world, A m^2
+  Mat3 rotation;   // cell frame -> world (the body's rotation)
+  Vec3 half;       // cuboid half extents, m; sphere: (R, R, R)
+  double volume;   // m^3 of the uniformly magnetized solid the cell stands for
+  Vec3 body_centre;  // the cell's body, world
+  double near2;      // within this squared distance of the body centre, exact fields
+  int kind;
+};
+
+// Near a body (within this many times its bounding radius) its cuboid cells
+// give their exact fields; farther, all of them are point dipoles, whose sum
+// over a lattice body is accurate to O((h / distance)^4) with the errors of
+// neighbouring cells cancelling. The choice is made per body: mixing exact and
+// dipole cells within one body would lose that cancellation.
+inline constexpr double kProbeNearBodies = 12.0;
+
+// H (A/m) of one cell at a world point.
+ODEMAG_HD Vec3 probe_cell_field(const ProbeCell& c, const Vec3& point) {
+  const Vec3 r = point - c.position;
+  if (c.kind == ProbeCell::sphere) return uniform_sphere_field(r, c.half.x, c.moment);
+  if (squared_norm(point - c.body_centre) > c.near2) return dipole_field(r, c.moment, 0.0);
+  const Vec3 M_local = c.rotation.transpose_times(c.moment) / c.volume;
+  return c.rotation * uniform_cuboid_field(c.rotation.transpose_times(r), c.half, M_local);
+}
+
+}  // namespace odemag

@@ -1,0 +1,18 @@
+// Field probes: the sources of `odemag field` and field lines.
+#pragma once
+
+#include <vector>
+
+#include "magnetics/cell_field.h"
+#include "magnetics/model.h"
+#include "magnetics/state.h"
+
+namespace odemag {
+
+// Every cell of an active magnetic body as the uniformly magnetized solid it
+// stands for: a cube of edge h for lattice cells, the body's box or sphere
+// for single-cell boxes and spheres, the sphere of equal volume for a
+// single-cell cylinder (an approximation inside and near it).
+std::vector<ProbeCell> probe_cells(const MagneticModel& model, const MagneticState& state);
+
+}  // namespace odemag
