@@ -22,8 +22,11 @@ ODEMAG_HD Vec3 uniform_sphere_field(const Vec3& r, double R, const Vec3& mu) {
 // log(Z2 + R2) - log(Z1 + R1) at the same (X, Y): the difference that the
 // cuboid's off-diagonal terms need, written so that it stays finite on the
 // line of an edge beyond its end (Z + R = (X^2 + Y^2) / (R - Z) for Z < 0).
-ODEMAG_HD double log_pair(double X, double Y, double Z1, double Z2) {
-  const double rho2 = X * X + Y * Y;
+// On the edge itself (rho = 0 between the ends) the field of one cuboid
+// diverges; rho is floored at eps there, so that on an edge shared by
+// neighbouring cubes of a lattice their equal and opposite terms cancel.
+ODEMAG_HD double log_pair(double X, double Y, double Z1, double Z2, double eps) {
+  const double rho2 = fmax(X * X + Y * Y, eps * eps);
   const double R1 = sqrt(rho2 + Z1 * Z1), R2 = sqrt(rho2 + Z2 * Z2);
   if (Z1 >= 0.0 && Z2 >= 0.0) return log((Z2 + R2) / (Z1 + R1));
   if (Z1 < 0.0 && Z2 < 0.0) return log((R1 - Z1) / (R2 - Z2));
@@ -43,14 +46,19 @@ ODEMAG_HD double corner_angle(double X, double Y, double Z) {
 //   N_xx = -(1/4pi) sum s atan(Y Z / (X R)),  N_xy = (1/4pi) sum s log(Z + R),
 // with X = x - x', etc., and the other components by permutation.
 // N(0) = I/3 for a cube. Six components (xx, xy, xz, yy, yz, zz).
+// Points within 1e-12 of the size of a face plane count as on it (both
+// sides then take the mean, so a point on a face shared by two lattice cubes
+// gets a consistent value from each, whatever the round-off of its position).
 ODEMAG_HD void cuboid_demag_tensor(const Vec3& p, const Vec3& half, double n[6]) {
   const double k = 1.0 / (4.0 * kPi);
+  const double eps = 1e-12 * (half.x + half.y + half.z);
+  auto snap = [eps](double v) { return fabs(v) < eps ? 0.0 : v; };
   double xx = 0, yy = 0, zz = 0, xy = 0, xz = 0, yz = 0;
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j)
       for (int l = 0; l < 2; ++l) {
         const double sx = i ? 1.0 : -1.0, sy = j ? 1.0 : -1.0, sz = l ? 1.0 : -1.0;
-        const double X = p.x - sx * half.x, Y = p.y - sy * half.y, Z = p.z - sz * half.z;
+        const double X = snap(p.x - sx * half.x), Y = snap(p.y - sy * half.y), Z = snap(p.z - sz * half.z);
         const double s = sx * sy * sz;
         xx -= s * corner_angle(X, Y, Z);
         yy -= s * corner_angle(Y, X, Z);
@@ -61,9 +69,12 @@ ODEMAG_HD void cuboid_demag_tensor(const Vec3& p, const Vec3& half, double n[6])
     for (int j = 0; j < 2; ++j) {
       const double s1 = i ? 1.0 : -1.0, s2 = j ? 1.0 : -1.0, s = s1 * s2;
       // xy: pairs along z, with X, Y at the corner.
-      xy += s * log_pair(p.x - s1 * half.x, p.y - s2 * half.y, p.z + half.z, p.z - half.z);
-      xz += s * log_pair(p.x - s1 * half.x, p.z - s2 * half.z, p.y + half.y, p.y - half.y);
-      yz += s * log_pair(p.y - s1 * half.y, p.z - s2 * half.z, p.x + half.x, p.x - half.x);
+      xy += s * log_pair(snap(p.x - s1 * half.x), snap(p.y - s2 * half.y), snap(p.z + half.z),
+                         snap(p.z - half.z), eps);
+      xz += s * log_pair(snap(p.x - s1 * half.x), snap(p.z - s2 * half.z), snap(p.y + half.y),
+                         snap(p.y - half.y), eps);
+      yz += s * log_pair(snap(p.y - s1 * half.y), snap(p.z - s2 * half.z), snap(p.x + half.x),
+                         snap(p.x - half.x), eps);
     }
   n[0] = k * xx;
   n[1] = k * xy;
