@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages odemag needs, only those that are missing.
+# Runs as root (or with sudo). Usage: scripts/install-deps.sh [extra packages...]
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libode-dev libeigen3-dev libosmesa6-dev libpng-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev
+  gnuplot-nox
+  "$@"
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+echo "odemag: installing ${missing[*]}" >&2
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
