@@ -159,7 +159,6 @@ void Simulation::step() {
   apply_timeline(dt);
   StepRecord record;
   record.time = time_;
-  record.magnetic_solves = 0;
   auto update_forces = [&](double t, double h) {
     // T_m: relaxation, forces and torques.
     const auto t0 = std::chrono::steady_clock::now();
@@ -169,7 +168,6 @@ void Simulation::step() {
     record.iterations += report.iterations;
     record.converged = record.converged && report.converged;
     record.residual = std::max(record.residual, report.residual);
-    ++record.magnetic_solves;
   };
   update_forces(time_, dt);
   // Substeps, each with its own forces: holding one step's forces over

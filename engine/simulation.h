@@ -18,9 +18,8 @@ struct StepRecord {
   double time = 0.0;         // at the start of the step, s
   double magnetic_ms = 0.0;  // T_m: relaxation, forces and torques
   double rigid_ms = 0.0;     // T_r: collision, dWorldQuickStep, contacts
-  int substeps = 1;          // rigid substeps (collision checks) in this step
-  int magnetic_solves = 1;   // relaxations in this step (one per substep)
-  int iterations = 0;        // outer relaxation iterations
+  int substeps = 1;          // substeps, each with its own relaxation and collision check
+  int iterations = 0;        // outer relaxation iterations, summed over the substeps
   bool converged = true;
   double residual = 0.0;
 };

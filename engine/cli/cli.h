@@ -4,13 +4,23 @@
 // other exception: exit 1).
 #pragma once
 
+#include <cstdio>
+#include <functional>
 #include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include <memory>
+
+#include "engine/scene.h"
+#include "magnetics/backend.h"
 #include "magnetics/vec3.h"
+
+namespace odemag {
+class Simulation;
+}
 
 namespace odemag::cli {
 
@@ -48,9 +58,28 @@ std::vector<Vec3> parse_points(const std::string& text, const std::string& file)
 // Reads the points file ("-": standard input); `file` in messages.
 std::vector<Vec3> read_points(const std::string& path);
 
-// The commands: each writes its whole output at once and returns the exit status.
+// The scene file of a command: its one positional argument.
+std::string scene_argument(const std::string& command, const Arguments& args);
+// The backend the options or the scene ask for; a fallback notice goes to
+// stderr as one line. An unavailable backend is a usage or scene error.
+std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene, const SolveOptions& o);
+
+// The commands. solve and field write their whole output at once; run writes
+// its files atomically (docs/run-output.md). Each returns the exit status.
 int run_solve(const std::vector<std::string>& args);
 int run_field(const std::vector<std::string>& args);
+
+// Draws frames of a running simulation (the OSMesa renderer in demos/
+// provides one; without it `run` writes no frames).
+class FrameWriter {
+ public:
+  virtual ~FrameWriter() = default;
+  // Writes the current state as a PNG at path (atomically).
+  virtual void write(const Simulation& simulation, const std::string& path) = 0;
+};
+using FrameWriterFactory =
+    std::function<std::unique_ptr<FrameWriter>(const SceneDescription& scene)>;
+int run_simulation(const std::vector<std::string>& args, const FrameWriterFactory& frames);
 
 // The text with control characters (newlines included) replaced by spaces:
 // messages on stderr are one line each.
@@ -58,6 +87,27 @@ std::string one_line(const std::string& text);
 
 // Writes text to stdout in one piece; throws std::runtime_error when it fails.
 void write_stdout(const std::string& text);
+
+// Writes a whole file atomically: to PATH.tmp-PID, fsync, rename over PATH.
+// Throws std::runtime_error (naming the file) on failure, leaving PATH as it was.
+void write_file_atomically(const std::string& path, const std::string& content);
+
+// A file written piece by piece (per-frame state): it is PATH.partial until
+// finish() renames it to PATH, so an interrupted run never leaves a
+// truncated file under the final name.
+class StreamedFile {
+ public:
+  explicit StreamedFile(std::string path);
+  ~StreamedFile();
+  StreamedFile(const StreamedFile&) = delete;
+  StreamedFile& operator=(const StreamedFile&) = delete;
+  void append(const std::string& text);
+  void finish();
+
+ private:
+  std::string path_, partial_;
+  std::FILE* file_ = nullptr;
+};
 
 // Usage text for --help.
 const char* usage_text();

@@ -28,9 +28,7 @@ int dispatch(const std::string& command, const std::vector<std::string>& args) {
   }
   if (command == "solve") return odemag::cli::run_solve(args);
   if (command == "field") return odemag::cli::run_field(args);
-  // `run` (ODE simulation, frames and per-frame state) is added with the
-  // simulation engine; dispatch to it here.
-  if (command == "run") throw odemag::cli::UsageError("'run' is not available yet in this build");
+  if (command == "run") return odemag::cli::run_simulation(args, odemag::cli::FrameWriterFactory{});
   throw odemag::cli::UsageError("unknown command '" + command + "' (commands: solve, field, run, help)");
 }
 

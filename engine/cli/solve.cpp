@@ -15,32 +15,6 @@ namespace odemag::cli {
 
 namespace {
 
-// The scene file: the one positional argument.
-std::string scene_argument(const std::string& command, const Arguments& args) {
-  if (args.positional.empty())
-    throw UsageError("'" + command + "' needs a scene file (see odemag --help)");
-  if (args.positional.size() > 1)
-    throw UsageError("'" + command + "' takes one scene file; unexpected argument '" +
-                     args.positional[1] + "'");
-  return args.positional[0];
-}
-
-// The backend the options or the scene ask for. A fallback notice goes to
-// stderr as one line.
-std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene, const SolveOptions& o) {
-  std::string notice;
-  std::unique_ptr<MagneticBackend> backend;
-  try {
-    backend = make_backend(o.backend.value_or(scene.solver.backend),
-                           o.threads.value_or(scene.solver.threads), &notice);
-  } catch (const std::invalid_argument& e) {
-    if (o.backend) throw UsageError(std::string("--backend: ") + e.what());
-    throw SceneError(scene.file, "solver.backend", e.what());
-  }
-  if (!notice.empty()) std::fprintf(stderr, "%s\n", one_line(notice).c_str());
-  return backend;
-}
-
 void warn_if_not_converged(const SceneDescription& scene, const RelaxReport& report) {
   if (report.converged) return;
   std::fprintf(stderr,
@@ -70,6 +44,32 @@ std::string vector(const Vec3& v) {
 }
 
 }  // namespace
+
+// The scene file: the one positional argument.
+std::string scene_argument(const std::string& command, const Arguments& args) {
+  if (args.positional.empty())
+    throw UsageError("'" + command + "' needs a scene file (see odemag --help)");
+  if (args.positional.size() > 1)
+    throw UsageError("'" + command + "' takes one scene file; unexpected argument '" +
+                     args.positional[1] + "'");
+  return args.positional[0];
+}
+
+// The backend the options or the scene ask for. A fallback notice goes to
+// stderr as one line.
+std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene, const SolveOptions& o) {
+  std::string notice;
+  std::unique_ptr<MagneticBackend> backend;
+  try {
+    backend = make_backend(o.backend.value_or(scene.solver.backend),
+                           o.threads.value_or(scene.solver.threads), &notice);
+  } catch (const std::invalid_argument& e) {
+    if (o.backend) throw UsageError(std::string("--backend: ") + e.what());
+    throw SceneError(scene.file, "solver.backend", e.what());
+  }
+  if (!notice.empty()) std::fprintf(stderr, "%s\n", one_line(notice).c_str());
+  return backend;
+}
 
 std::string one_line(const std::string& text) {
   std::string s = text;

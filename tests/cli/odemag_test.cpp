@@ -306,6 +306,55 @@ TEST_F(Cli, UsageErrorsExitTwo) {
   EXPECT_EQ(bad_backend.status, 2);
 }
 
+TEST_F(Cli, RunWritesStatePerFrameSummaryAndNoPartialFiles) {
+  const fs::path out = dir_ / "run";
+  const ProgramRun r = odemag("run " + shell_quote(kExamples + "drop_on_magnet.json") + " --out " +
+                              shell_quote(out.string()) +
+                              " --duration 0.6 --frame-rate 10 --frames no --quiet yes --backend cpu");
+  ASSERT_EQ(r.status, 0) << r.err;
+  // One state line per frame at t = 0, 0.1, ..., 0.6 s, every body in each.
+  const auto state = lines(read_file(out / "state.jsonl"));
+  ASSERT_EQ(state.size(), 7u);
+  for (size_t k = 0; k < state.size(); ++k) {
+    const json frame = json::parse(state[k]);
+    EXPECT_EQ(frame["frame"], k);
+    EXPECT_NEAR(frame["time"].get<double>(), 0.1 * static_cast<double>(k), 1e-9);
+    ASSERT_EQ(frame["bodies"].size(), 4u);
+    for (const char* key : {"name", "present", "position", "orientation", "velocity", "angular_velocity",
+                            "moment", "force", "torque"})
+      EXPECT_TRUE(frame["bodies"][2].contains(key)) << key;
+  }
+  // The magnet is magnetized from the first frame on; ball_2 appears at 0.5 s.
+  EXPECT_GT(json::parse(state[0])["bodies"][1]["moment"][2].get<double>(), 1.0);
+  EXPECT_FALSE(json::parse(state[4])["bodies"][3]["present"].get<bool>());
+  EXPECT_TRUE(json::parse(state[6])["bodies"][3]["present"].get<bool>());
+  const json summary = json::parse(read_file(out / "summary.json"));
+  EXPECT_EQ(summary["steps"], 300);
+  EXPECT_EQ(summary["frames"], 7);
+  for (const char* key : {"magnetic_ms", "rigid_ms", "iterations", "substeps"})
+    for (const char* stat : {"median", "p90", "mean", "max", "total"})
+      EXPECT_TRUE(summary[key].contains(stat)) << key << "." << stat;
+  EXPECT_TRUE(summary["outcomes"].contains("balls_left"));
+  // Nothing under a temporary or partial name is left behind.
+  for (const auto& entry : fs::directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(name.find(".partial"), std::string::npos) << name;
+    EXPECT_EQ(name.find(".tmp-"), std::string::npos) << name;
+  }
+}
+
+TEST_F(Cli, RunRejectsBadOptions) {
+  const std::string scene = shell_quote(kExamples + "drop_on_magnet.json");
+  const std::string out = " --out " + shell_quote((dir_ / "o").string());
+  for (const std::string& args : {"run " + scene, "run " + scene + out + " --duration -1",
+                                 "run " + scene + out + " --time-step 0", "run " + scene + out + " --frames maybe",
+                                 "run " + scene + out + " --width 3"}) {
+    const ProgramRun r = odemag(args);
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_EQ(lines(r.err).size(), 1u) << args << ": " << r.err;
+  }
+}
+
 TEST_F(Cli, HelpExitsZero) {
   for (const char* args : {"--help", "help"}) {
     const ProgramRun r = odemag(args);

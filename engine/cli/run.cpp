@@ -1,0 +1,216 @@
+// `odemag run SCENE --out DIR`: simulate with ODE and write per-frame state,
+// frames (when a renderer is available) and a summary (docs/run-output.md).
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numeric>
+
+#include <nlohmann/json.hpp>
+
+#include "engine/cli/cli.h"
+#include "engine/simulation.h"
+
+namespace odemag::cli {
+
+namespace {
+
+using json = nlohmann::ordered_json;
+
+json vec(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+double number_option(const Arguments& a, const std::string& name, double fallback, bool allow_zero) {
+  const auto v = a.option(name);
+  if (!v) return fallback;
+  char* end = nullptr;
+  const double x = std::strtod(v->c_str(), &end);
+  if (end == v->c_str() || *end != '\0' || !std::isfinite(x) || x < 0.0 || (!allow_zero && x == 0.0))
+    throw UsageError("--" + name + ": expected a " + (allow_zero ? "non-negative" : "positive") +
+                     " number, got '" + *v + "'");
+  return x;
+}
+
+int int_option(const Arguments& a, const std::string& name, int fallback, int lo, int hi) {
+  const double x = number_option(a, name, fallback, true);
+  if (x != std::floor(x) || x < lo || x > hi)
+    throw UsageError("--" + name + ": expected an integer from " + std::to_string(lo) + " to " +
+                     std::to_string(hi));
+  return static_cast<int>(x);
+}
+
+bool yes_no_option(const Arguments& a, const std::string& name, bool fallback) {
+  const auto v = a.option(name);
+  if (!v) return fallback;
+  if (*v == "yes" || *v == "true" || *v == "1") return true;
+  if (*v == "no" || *v == "false" || *v == "0") return false;
+  throw UsageError("--" + name + ": expected yes or no, got '" + *v + "'");
+}
+
+// Median, 90th percentile (nearest rank), mean, max and total of a sample.
+json statistics(std::vector<double> x) {
+  if (x.empty()) return json::object();
+  std::sort(x.begin(), x.end());
+  const double n = static_cast<double>(x.size());
+  auto rank = [&](double p) { return x[std::min(x.size(), static_cast<size_t>(std::ceil(p * n))) - 1]; };
+  const double total = std::accumulate(x.begin(), x.end(), 0.0);
+  return {{"median", rank(0.5)}, {"p90", rank(0.9)}, {"mean", total / n}, {"max", x.back()},
+          {"total", total}};
+}
+
+json frame_state(const Simulation& sim, int frame) {
+  json bodies = json::array();
+  const SceneDescription& scene = sim.scene();
+  for (int b = 0; b < sim.world().body_count(); ++b) {
+    const dReal* q = dBodyGetQuaternion(sim.world().body(b));
+    bodies.push_back({{"name", scene.bodies[b].name},
+                      {"present", sim.world().enabled(b)},
+                      {"position", vec(sim.world().pose(b).position)},
+                      {"orientation", json::array({q[0], q[1], q[2], q[3]})},
+                      {"velocity", vec(sim.world().velocity(b))},
+                      {"angular_velocity", vec(sim.world().angular_velocity(b))},
+                      {"moment", vec(sim.magnetics().moment(b))},
+                      {"force", vec(sim.magnetics().force(b))},
+                      {"torque", vec(sim.magnetics().torque(b))}});
+  }
+  return {{"frame", frame}, {"time", sim.time()}, {"bodies", bodies}};
+}
+
+// Stops the run when a body's state is NaN or infinite; nothing of that step
+// is written.
+void check_finite(const Simulation& sim) {
+  for (int b = 0; b < sim.world().body_count(); ++b)
+    if (!sim.finite_state(b))
+      throw std::runtime_error(sim.scene().file + ": body '" + sim.scene().bodies[b].name +
+                               "' has a non-finite state at step " + std::to_string(sim.steps()) +
+                               " (t = " + std::to_string(sim.time()) + " s); stopped");
+}
+
+class Progress {
+ public:
+  Progress(double duration, bool quiet) : duration_(duration), quiet_(quiet), tty_(isatty(STDERR_FILENO)) {}
+  void update(const Simulation& sim, bool last = false) {
+    if (quiet_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (!last && now - shown_ < std::chrono::seconds(tty_ ? 1 : 10)) return;
+    shown_ = now;
+    const auto& r = sim.records();
+    double tm = 0, tr = 0;
+    const size_t window = std::min<size_t>(r.size(), 100);
+    for (size_t i = r.size() - window; i < r.size(); ++i) tm += r[i].magnetic_ms, tr += r[i].rigid_ms;
+    if (window) tm /= static_cast<double>(window), tr /= static_cast<double>(window);
+    std::fprintf(stderr, "%sodemag run: t = %.3f / %.3f s (%3.0f%%), %ld steps, T_m %.2f ms, T_r %.2f ms per step%s",
+                 tty_ ? "\r" : "", sim.time(), duration_, duration_ > 0 ? 100.0 * sim.time() / duration_ : 100.0,
+                 sim.steps(), tm, tr, tty_ && !last ? "" : "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  double duration_;
+  bool quiet_, tty_;
+  std::chrono::steady_clock::time_point shown_{};
+};
+
+std::string frame_name(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05d.png", frame);
+  return name;
+}
+
+}  // namespace
+
+int run_simulation(const std::vector<std::string>& args, const FrameWriterFactory& frames) {
+  const Arguments a = parse_arguments(
+      "run", args,
+      {"out", "duration", "frame-rate", "time-step", "frames", "width", "height", "backend", "threads", "quiet"});
+  const std::string scene_file = scene_argument("run", a);
+  const auto out = a.option("out");
+  if (!out || out->empty()) throw UsageError("'run' needs --out DIR (see odemag --help)");
+  const SolveOptions options = solve_options(a);
+
+  SceneDescription scene = load_scene(scene_file);
+  SimulationSettings& settings = scene.simulation;
+  settings.duration = number_option(a, "duration", settings.duration, true);
+  settings.frame_rate = number_option(a, "frame-rate", settings.frame_rate, false);
+  settings.time_step = number_option(a, "time-step", settings.time_step, false);
+  scene.camera.width = int_option(a, "width", scene.camera.width, 16, 8192);
+  scene.camera.height = int_option(a, "height", scene.camera.height, 16, 8192);
+  const bool want_frames = yes_no_option(a, "frames", true);
+  const bool quiet = yes_no_option(a, "quiet", false);
+
+  std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
+  const std::string backend_name = backend->name();
+  Simulation sim(scene, std::move(backend));
+
+  std::error_code ec;
+  std::filesystem::create_directories(*out, ec);
+  if (ec) throw std::runtime_error("cannot create output directory " + *out + ": " + ec.message());
+  const std::filesystem::path dir(*out);
+  std::unique_ptr<FrameWriter> frame_writer;
+  if (want_frames && frames) frame_writer = frames(scene);
+  if (want_frames && !frame_writer)
+    std::fprintf(stderr, "odemag run: this build has no renderer; writing state without frames\n");
+
+  StreamedFile state_file((dir / "state.jsonl").string());
+  Progress progress(settings.duration, quiet);
+  const auto started = std::chrono::steady_clock::now();
+  int frame = 0;
+  double next_frame_time = 0.0;
+  auto emit_frame = [&] {
+    state_file.append(frame_state(sim, frame).dump() + "\n");
+    if (frame_writer) frame_writer->write(sim, (dir / frame_name(frame)).string());
+    ++frame;
+    next_frame_time = frame / settings.frame_rate;
+  };
+  sim.magnetics().compute();  // frame 0 shows the relaxed initial magnetization
+  emit_frame();
+  while (sim.time() + 0.5 * settings.time_step < settings.duration) {
+    sim.step();
+    check_finite(sim);
+    if (sim.time() + 0.5 * settings.time_step >= next_frame_time) emit_frame();
+    progress.update(sim);
+  }
+  sim.finish();
+  state_file.finish();
+  progress.update(sim, true);
+
+  // summary.json: the cost of every rigid step and the scene's outcomes.
+  std::vector<double> tm, tr, iterations, substeps;
+  long not_converged = 0;
+  for (const StepRecord& r : sim.records()) {
+    tm.push_back(r.magnetic_ms);
+    tr.push_back(r.rigid_ms);
+    iterations.push_back(r.iterations);
+    substeps.push_back(r.substeps);
+    if (!r.converged) ++not_converged;
+  }
+  const MagneticModel& model = sim.magnetics().model();
+  json outcomes = json::object();
+  for (const auto& [name, value] : sim.outcomes()) outcomes[name] = value;
+  const json summary = {
+      {"scene", scene.file},
+      {"title", scene.title},
+      {"backend", backend_name},
+      {"bodies", model.body_count()},
+      {"cells", model.cell_count()},
+      {"responsive_cells", model.responsive_cell_count()},
+      {"time_step", settings.time_step},
+      {"duration", sim.time()},
+      {"steps", sim.steps()},
+      {"frames", frame},
+      {"frames_written", frame_writer != nullptr},
+      {"wall_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()},
+      {"magnetic_ms", statistics(tm)},
+      {"rigid_ms", statistics(tr)},
+      {"iterations", statistics(iterations)},
+      {"substeps", statistics(substeps)},  // one relaxation per substep
+      {"steps_not_converged", not_converged},
+      {"outcomes", outcomes},
+  };
+  write_file_atomically((dir / "summary.json").string(), summary.dump(2) + "\n");
+  return 0;
+}
+
+}  // namespace odemag::cli
