@@ -28,9 +28,17 @@ constexpr int kMaxContacts = 8;
 // of falling freely into the magnet during the next substep (docs/simulation.md).
 constexpr double kSkinFraction = 0.02;
 
+// "auto" uses ODE's direct solver up to this many dynamic bodies (its cost
+// grows with the cube of the contacts of an island).
+constexpr long kExactSolverBodies = 32;
+
 }  // namespace
 
 RigidWorld::RigidWorld(const SceneDescription& scene) : contact_(scene.simulation.contact) {
+  const long dynamic = std::count_if(scene.bodies.begin(), scene.bodies.end(),
+                                     [](const BodyDescription& b) { return !b.fixed; });
+  const std::string& solver = scene.simulation.contact_solver;
+  exact_solver_ = solver == "exact" || (solver == "auto" && dynamic <= kExactSolverBodies);
   ensure_ode_initialised();
   world_ = dWorldCreate();
   space_ = dHashSpaceCreate(nullptr);
@@ -131,7 +139,11 @@ void RigidWorld::integrate(double h) {
   for (ForceAccumulator* a : accumulators_) a->add_forces();
   for (Body& b : bodies_) b.in_contact = false;
   dSpaceCollide(space_, this, &RigidWorld::near_callback);
-  dWorldQuickStep(world_, h);
+  if (exact_solver_) {
+    dWorldStep(world_, h);
+  } else {
+    dWorldQuickStep(world_, h);
+  }
   dJointGroupEmpty(contacts_);
 }
 

@@ -74,6 +74,7 @@ class RigidWorld {
   std::vector<Body> bodies_;
   std::vector<ForceAccumulator*> accumulators_;
   ContactSettings contact_;
+  bool exact_solver_ = false;
 };
 
 }  // namespace odemag

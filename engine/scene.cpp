@@ -445,13 +445,16 @@ SolverSettings read_solver(const SceneReader& r, const json& v, const std::strin
 }
 
 SimulationSettings read_simulation(const SceneReader& r, const json& v, const std::string& path) {
-  r.check_keys(v, path, {"time_step", "duration", "frame_rate", "solver_iterations", "ground",
+  r.check_keys(v, path, {"time_step", "duration", "frame_rate", "contact_solver", "solver_iterations", "ground",
                          "ground_height", "contact", "linear_damping", "angular_damping",
                          "max_substeps", "stiffness_limit"});
   SimulationSettings s;
   r.optional(v, "time_step", path, [&](const json& x, const std::string& p) { s.time_step = r.positive(x, p); });
   r.optional(v, "duration", path, [&](const json& x, const std::string& p) { s.duration = r.non_negative(x, p); });
   r.optional(v, "frame_rate", path, [&](const json& x, const std::string& p) { s.frame_rate = r.positive(x, p); });
+  r.optional(v, "contact_solver", path, [&](const json& x, const std::string& p) {
+    s.contact_solver = r.choice(x, p, {"auto", "quick", "exact"});
+  });
   r.optional(v, "solver_iterations", path, [&](const json& x, const std::string& p) {
     s.solver_iterations = r.int_value(x, p, 1, 1000000);
   });

@@ -1,5 +1,6 @@
 #include "magnetics/cells.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "magnetics/constants.h"
@@ -13,7 +14,7 @@ CellSet make_cells(const Shape& shape, double cell_size) {
     const Vec3 half = shape_half_extents(shape);
     std::array<int, 3> n{};
     for (int a = 0; a < 3; ++a)
-      n[a] = std::max(1, static_cast<int>(std::lround(2.0 * half[a] / cell_size)));
+      n[a] = std::max(1, static_cast<int>(std::floor(2.0 * half[a] / cell_size + 1e-9)));
     const double tol = 1e-9 * cell_size;
     for (int k = 0; k < n[2]; ++k)
       for (int j = 0; j < n[1]; ++j)
@@ -35,6 +36,12 @@ CellSet make_cells(const Shape& shape, double cell_size) {
   }
   cells.cell_volume = volume / static_cast<double>(cells.size());
   cells.cell_radius = std::cbrt(3.0 * cells.cell_volume / (4.0 * kPi));
+  if (cells.spacing > 0.0) {
+    cells.contact_radius = 0.5 * cells.spacing;
+  } else {
+    const Vec3 half = shape_half_extents(shape);
+    cells.contact_radius = std::min({half.x, half.y, half.z});
+  }
   return cells;
 }
 

@@ -20,14 +20,22 @@ struct CellSet {
   double spacing = 0.0;                         // h, m; 0 for a single cell
   double cell_volume = 0.0;                     // V, m^3
   double cell_radius = 0.0;                     // radius of the sphere of volume V, m
+  // Radius of the sphere inscribed in the solid a cell stands for: h/2 for a
+  // lattice cell (centre to the face of its cube), R for a one-cell ball, the
+  // smallest half extent for another one-cell body. Two cells of different
+  // bodies interact through the exact dipole kernel while their centres are
+  // farther apart than the sum of their contact radii, so bodies that touch
+  // never reach the bounded core (magnetics/kernels.h).
+  double contact_radius = 0.0;
 
   int size() const { return static_cast<int>(local_positions.size()); }
 };
 
 // Cells of a shape on a lattice of spacing h = cell_size. With cell_size <= 0
 // (or a lattice coarser than the shape) the body is one cell at its centre.
-// Per axis the lattice has max(1, round(extent / h)) points spaced h apart and
-// centred on the body; points inside the shape become cells.
+// Per axis the lattice has max(1, floor(extent / h)) points spaced h apart and
+// centred on the body, so no cell's cube reaches beyond the body; points
+// inside the shape become cells.
 CellSet make_cells(const Shape& shape, double cell_size);
 
 }  // namespace odemag

@@ -18,7 +18,7 @@ constexpr long kParallelPairs = 20000;
 
 // Cells as structure of arrays, for the pair loops.
 struct CellArrays {
-  std::vector<double> x, y, z, radius, mx, my, mz;  // position, radius, moment mu = M V
+  std::vector<double> x, y, z, radius, mx, my, mz;  // position, contact radius, moment mu = M V
   std::vector<int> cell, body;
   void clear() {
     for (auto* v : {&x, &y, &z, &radius, &mx, &my, &mz}) v->clear();
@@ -29,7 +29,7 @@ struct CellArrays {
   void push(const MagneticModel& model, const MagneticState& state, int c) {
     const Vec3& p = state.cell_position[c];
     x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
-    radius.push_back(model.body(model.cell_body(c)).cells.cell_radius);
+    radius.push_back(model.body(model.cell_body(c)).cells.contact_radius);
     mx.push_back(0), my.push_back(0), mz.push_back(0);
     cell.push_back(c);
     body.push_back(model.cell_body(c));

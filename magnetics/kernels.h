@@ -9,7 +9,8 @@
 //   F_b = mu0 [ B ((r.mu_a) mu_b + (r.mu_b) mu_a + (mu_a.mu_b) r) + C (r.mu_a)(r.mu_b) r ],
 // with C = B'(r)/r = -15/(4 pi r^7); A'(r)/r = B for every radial g.
 //
-// Overlap: below the contact distance s (sum of the two cell radii) g is
+// Overlap: below the contact distance s (sum of the two cells' contact radii,
+// magnetics/cells.h) g is
 // replaced by the even polynomial c0 + c1 r^2 + c2 r^4 + c3 r^6 that matches
 // g, g', g'', g''' at s. Then A, B and C are polynomials: fields and forces
 // are bounded, continuous at s, exactly dipolar for r >= s, and still the

@@ -197,7 +197,7 @@ double magnetic_energy(const MagneticModel& model, const MagneticState& state) {
       if (!state.active[bb]) continue;
       const MagneticBody& body_b = model.body(bb);
       const Vec3 mu_b = body_b.cells.cell_volume * state.magnetization[b];
-      const double s = ba == bb ? 0.0 : body_a.cells.cell_radius + body_b.cells.cell_radius;
+      const double s = ba == bb ? 0.0 : body_a.cells.contact_radius + body_b.cells.contact_radius;
       e += dipole_energy(state.cell_position[b] - state.cell_position[a], mu_a, mu_b, s * s);
     }
     if (body_a.kind == CellKind::soft) {
