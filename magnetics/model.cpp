@@ -9,6 +9,12 @@ namespace odemag {
 
 namespace {
 
+// Intra-body tensors act on moments mu = M V (H = T mu). The cube-cube tensor
+// maps magnetization to field (H = -N M), so T = -N / V with V the cell's own
+// volume: the intra-body operator is then that of the cube tiling whatever V
+// is (V differs from h^3 for shapes that are not boxes of whole cells), and
+// keeps its stability. (Dividing by h^3 instead made a cylinder's cells, with
+// V = 1.13 h^3, hold each other saturated: a spurious remanence.)
 void build_offset_tensors(MagneticBody& body, IntraBodyTensor kind) {
   const auto& n = body.cells.lattice_extent;
   body.offset_extent = {2 * n[0] - 1, 2 * n[1] - 1, 2 * n[2] - 1};
@@ -27,7 +33,7 @@ void build_offset_tensors(MagneticBody& body, IntraBodyTensor kind) {
         } else {
           double n_tensor[6];
           cube_demag_tensor(di, dj, dk, h, n_tensor);
-          for (int a = 0; a < 6; ++a) t[a] = -n_tensor[a] / (h * h * h);
+          for (int a = 0; a < 6; ++a) t[a] = -n_tensor[a] / body.cells.cell_volume;
         }
       }
 }

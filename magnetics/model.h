@@ -35,8 +35,9 @@ struct MagneticBody {
   double recoil = 0.0;   // chi_r for permanent bodies
 
   // Intra-body interaction tensors, computed once per body: H = T(d) mu for
-  // every lattice offset d (six components, body frame). T = -N(d) / h^3 with
-  // N the cube-cube tensor, or the point dipole (magnetics/demag_tensor.h).
+  // every lattice offset d (six components, body frame). T = -N(d) / V with N
+  // the cube-cube tensor and V the cell volume, or the point dipole
+  // (magnetics/demag_tensor.h).
   std::vector<double> offset_tensors;
   std::array<int, 3> offset_extent{0, 0, 0};  // 2 n - 1 per axis
 
