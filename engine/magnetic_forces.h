@@ -67,7 +67,8 @@ class MagneticForces : public ForceAccumulator {
 
   int body_count() const { return model_.body_count(); }
   dBodyID ode_body(int index) const { return bodies_[index]; }
-  Vec3 moment(int index) const { return body_moment(model_, state_, index); }  // A m^2, world
+  // A m^2, world; zero for a body that is not active.
+  Vec3 moment(int index) const { return active(index) ? body_moment(model_, state_, index) : Vec3{}; }
   Vec3 force(int index) const { return state_.force[index]; }                  // N, world
   Vec3 torque(int index) const { return state_.torque[index]; }                // N m, about the CoM
 

@@ -133,25 +133,25 @@ void Simulation::apply_timeline(double dt) {
 
 int Simulation::substeps_needed(double dt) const {
   const int cap = std::max(1, scene_.simulation.max_substeps);
-  double worst = 0.0;
+  double shortest = dt;  // longest admissible substep
   for (int b = 0; b < world_->body_count(); ++b) {
     if (world_->kinematic(b) || !world_->enabled(b)) continue;
     const double f = norm(magnetics_->force(b)), m = world_->mass(b), size = body_size_[b];
-    // Collision: travel per substep, at the current velocity and the full
-    // acceleration of gravity and magnetic force, at most a tenth of the
-    // body's size; three tenths for a body that was in contact, which the
-    // contact most likely still holds (it may have lifted off by a hair, so
-    // its acceleration still counts).
-    const double a = f / m + norm(scene_.gravity);
-    const double allowed = (world_->in_contact(b) ? 0.3 : 0.1) * size;
-    worst = std::max(worst, (norm(world_->velocity(b)) * dt + 0.5 * a * dt * dt) / allowed);
+    // Collision: the travel v h + a h^2 / 2 in one substep, at the current
+    // velocity and the full acceleration of gravity and magnetic force, at
+    // most L: a tenth of the body's size, three tenths for a body that was in
+    // contact (which most likely still holds it; it may have lifted off by a
+    // hair, so its acceleration still counts). Solved for h.
+    const double v = norm(world_->velocity(b)), a = f / m + norm(scene_.gravity);
+    const double L = (world_->in_contact(b) ? 0.3 : 0.1) * size;
+    shortest = std::min(shortest, 2.0 * L / (v + std::sqrt(v * v + 2.0 * a * L)));
     // Time scale of the magnetic force: it varies over distances of the
     // body's size, so it oscillates a body about an equilibrium at
     // omega^2 ~ |F| / (m size); the explicit update needs omega h <= limit.
-    worst = std::max(worst, dt * std::sqrt(f / (m * size)) / scene_.simulation.stiffness_limit);
+    if (f > 0.0) shortest = std::min(shortest, scene_.simulation.stiffness_limit / std::sqrt(f / (m * size)));
   }
-  if (!std::isfinite(worst)) return cap;
-  return std::clamp(static_cast<int>(std::ceil(worst)), 1, cap);
+  const double k = std::ceil(dt / shortest * (1.0 - 1e-12));
+  return std::isfinite(k) ? std::clamp(static_cast<int>(std::min(k, 1e9)), 1, cap) : cap;
 }
 
 void Simulation::step() {

@@ -189,19 +189,22 @@ ODEMAG_HD void tangent_basis(const Vec3& m, Vec3& u, Vec3& v) {
 
 // Newton's method on the product of unit spheres for the cell free energy,
 // with the Riemannian Hessian Hess[xi]_k = P_k (d2G xi)_k - (m_k . grad_k G) xi_k.
-// Steps use |eigenvalue| (descent at saddles), a 0.5 rad trust radius, and an
-// energy line search, so the energy never rises; at a converged saddle a step
-// along the negative-curvature direction leaves it (the role the noise field
-// plays for LLG). Converges quadratically in the basin the LLG steps chose;
-// it removes the slow "pair axis" mode that makes n = 2 LLG crawl in weak
-// fields (docs/model.md). Returns the steps taken.
+// Each step is Newton's (Cholesky) where the Hessian is positive definite;
+// elsewhere it uses |eigenvalue| (n = 2) or a Levenberg-Marquardt shift
+// (more moments, where a 16 x 16 eigen-decomposition per step was 98% of
+// the run time). A 0.5 rad trust radius and an
+// energy line search keep the energy from rising. At a converged point that
+// is a saddle (a Cholesky test fails) it steps along the negative curvature
+// found by an eigen-decomposition, the role the noise field plays for LLG. Converges quadratically in the basin the LLG
+// steps chose; it removes the slow "pair axis" mode that makes n = 2 LLG
+// crawl in weak fields (docs/model.md). Returns the steps taken.
 ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, int max_steps,
                             double tolerance, double& residual) {
   const int n = p.n, dim = 2 * n;
   constexpr int kMaxDim = 2 * kMaxMomentsPerCell;
   Vec3 basis[kMaxDim], heff[kMaxMomentsPerCell], trial[kMaxMomentsPerCell];
-  double hess[kMaxDim * kMaxDim], eval[kMaxDim], evec[kMaxDim * kMaxDim], grad[kMaxDim],
-      step[kMaxDim];
+  double hess[kMaxDim * kMaxDim], work[kMaxDim * kMaxDim], eval[kMaxDim], evec[kMaxDim * kMaxDim],
+      grad[kMaxDim], step[kMaxDim];
   const double inv_n = 1.0 / n;
   int steps = 0;
   residual = cell_torque_residual(p, H_A, m);
@@ -226,29 +229,57 @@ ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, i
         hess[a * dim + b] = h;
       }
     }
-    symmetric_eigen(hess, dim, eval, evec);
     const double curvature_scale = inv_n * (p.gamma_D * p.Ms + p.H_K + norm(H_A));
-    int lowest = 0;
-    for (int i = 1; i < dim; ++i)
-      if (eval[i] < eval[lowest]) lowest = i;
-    const bool saddle = eval[lowest] < -1e-8 * curvature_scale;
-    if (residual <= tolerance && !saddle) break;
-    double longest = 0.0;
     if (residual <= tolerance) {
-      // Converged onto a saddle: leave along the negative-curvature direction.
+      // Converged: a minimum (positive semi-definite Hessian, up to 1e-8 of
+      // the curvature scale), or a saddle to leave along its negative curvature.
+      for (int i = 0; i < dim * dim; ++i) work[i] = hess[i];
+      for (int a = 0; a < dim; ++a) work[a * dim + a] += 1e-8 * curvature_scale;
+      if (cholesky(work, dim, 0.0)) break;
+      for (int i = 0; i < dim * dim; ++i) work[i] = hess[i];
+      symmetric_eigen(work, dim, eval, evec);
+      int lowest = 0;
+      for (int i = 1; i < dim; ++i)
+        if (eval[i] < eval[lowest]) lowest = i;
       double sign = 0.0;
       for (int a = 0; a < dim; ++a)
         if (fabs(evec[a * dim + lowest]) > fabs(sign)) sign = evec[a * dim + lowest];
       for (int a = 0; a < dim; ++a) step[a] = (sign >= 0 ? 0.1 : -0.1) * evec[a * dim + lowest];
     } else {
-      for (int a = 0; a < dim; ++a) step[a] = 0.0;
-      for (int i = 0; i < dim; ++i) {
-        double vg = 0.0;
-        for (int a = 0; a < dim; ++a) vg += evec[a * dim + i] * grad[a];
-        const double lam = fmax(fabs(eval[i]), 1e-14 * curvature_scale);
-        for (int a = 0; a < dim; ++a) step[a] -= (vg / lam) * evec[a * dim + i];
+      // Newton (shift 1e-12 of the curvature scale for the zero modes) where
+      // the Hessian is positive definite. Otherwise: for n = 2 (4 x 4, cheap)
+      // the eigen-decomposition with |eigenvalue|, which keeps the full
+      // Newton step along the slow pair-axis mode of weak fields; for more
+      // moments a Levenberg-Marquardt step: the Hessian is the positive
+      // semi-definite endo and anisotropy parts plus the diagonal
+      // (m_k . H_eff,k) / n, so shifting by the most negative of those makes
+      // it positive definite without an eigen-decomposition of up to 16 x 16.
+      for (int i = 0; i < dim * dim; ++i) work[i] = hess[i];
+      for (int a = 0; a < dim; ++a) work[a * dim + a] += 1e-12 * curvature_scale;
+      bool factored = cholesky(work, dim, 0.0);
+      if (!factored && dim <= 4) {
+        for (int i = 0; i < dim * dim; ++i) work[i] = hess[i];
+        symmetric_eigen(work, dim, eval, evec);
+        for (int a = 0; a < dim; ++a) step[a] = 0.0;
+        for (int i = 0; i < dim; ++i) {
+          double vg = 0.0;
+          for (int a = 0; a < dim; ++a) vg += evec[a * dim + i] * grad[a];
+          const double lam = fmax(fabs(eval[i]), 1e-14 * curvature_scale);
+          for (int a = 0; a < dim; ++a) step[a] -= (vg / lam) * evec[a * dim + i];
+        }
+      } else {
+        if (!factored) {
+          double mu = 1e-12 * curvature_scale;
+          for (int k = 0; k < n; ++k) mu = fmax(mu, -inv_n * dot(m[k], heff[k]) + 1e-12 * curvature_scale);
+          for (int i = 0; i < dim * dim; ++i) work[i] = hess[i];
+          for (int a = 0; a < dim; ++a) work[a * dim + a] += mu;
+          factored = cholesky(work, dim, 0.0);
+        }
+        for (int a = 0; a < dim; ++a) step[a] = factored ? -grad[a] : -grad[a] / curvature_scale;
+        if (factored) cholesky_solve(work, dim, step);  // else round-off: a gradient step
       }
     }
+    double longest = 0.0;
     for (int k = 0; k < n; ++k) longest = fmax(longest, hypot(step[2 * k], step[2 * k + 1]));
     double t = longest > 0.5 ? 0.5 / longest : 1.0;
     const double e0 = cell_free_energy(p, H_A, m);

@@ -1,5 +1,6 @@
-// Eigen-decomposition of small symmetric matrices (cyclic Jacobi), usable on
-// host and device; used by the per-cell Newton polish (at most 16 x 16).
+// Small dense symmetric linear algebra, usable on host and device, for the
+// per-cell Newton polish (at most 16 x 16): eigen-decomposition (cyclic
+// Jacobi) and Cholesky.
 #pragma once
 
 #include <cmath>
@@ -45,6 +46,39 @@ ODEMAG_HD void symmetric_eigen(double* a, int n, double* eval, double* evec) {
       }
   }
   for (int i = 0; i < n; ++i) eval[i] = a[i * n + i];
+}
+
+// Cholesky factorisation of a symmetric matrix (row-major, lower triangle
+// overwritten by L with a = L L^T). Returns false when a is not positive
+// definite (a pivot <= tiny).
+ODEMAG_HD bool cholesky(double* a, int n, double tiny) {
+  for (int j = 0; j < n; ++j) {
+    double d = a[j * n + j];
+    for (int k = 0; k < j; ++k) d -= a[j * n + k] * a[j * n + k];
+    if (!(d > tiny)) return false;
+    d = sqrt(d);
+    a[j * n + j] = d;
+    for (int i = j + 1; i < n; ++i) {
+      double v = a[i * n + j];
+      for (int k = 0; k < j; ++k) v -= a[i * n + k] * a[j * n + k];
+      a[i * n + j] = v / d;
+    }
+  }
+  return true;
+}
+
+// Solves L L^T x = b in place (b becomes x) with the factor from cholesky().
+ODEMAG_HD void cholesky_solve(const double* l, int n, double* b) {
+  for (int i = 0; i < n; ++i) {
+    double v = b[i];
+    for (int k = 0; k < i; ++k) v -= l[i * n + k] * b[k];
+    b[i] = v / l[i * n + i];
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    double v = b[i];
+    for (int k = i + 1; k < n; ++k) v -= l[k * n + i] * b[k];
+    b[i] = v / l[i * n + i];
+  }
 }
 
 }  // namespace odemag

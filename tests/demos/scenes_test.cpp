@@ -1,0 +1,185 @@
+// The magnetic-shielding demo scenes (paper Sec. 5.2, Figs. 13 and 15) give
+// the paper's outcomes: a wood plate does not stop the steel ball, an iron
+// plate does until it is removed, a thin iron plate lets exactly one of three
+// balls be lifted and a thick one none. Each scene runs for its full duration
+// as written in demos/scenes/ (2-3 s of simulated time, about a second or two
+// of wall time on 2 cores).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <variant>
+
+#include "engine/scene.h"
+#include "engine/simulation.h"
+#include "magnetics/backend.h"
+#include "magnetics/constants.h"
+
+namespace odemag {
+namespace {
+
+std::string scene_path(const std::string& name) {
+  return std::string(ODEMAG_SOURCE_DIR) + "/demos/scenes/" + name + ".json";
+}
+
+const BodyDescription& body(const SceneDescription& s, const std::string& name) {
+  const int b = s.find_body(name);
+  EXPECT_GE(b, 0) << name;
+  return s.bodies.at(b);
+}
+
+double box_half_height(const BodyDescription& b) {
+  const Box* box = std::get_if<Box>(&b.shape);
+  EXPECT_NE(box, nullptr) << b.name << " is not a box";
+  return box ? 0.5 * box->size.z : 0.0;
+}
+
+double sphere_radius(const BodyDescription& b) {
+  const Sphere* s = std::get_if<Sphere>(&b.shape);
+  EXPECT_NE(s, nullptr) << b.name << " is not a sphere";
+  return s ? s->radius : 0.0;
+}
+
+double height_of(const Simulation& sim, const std::string& name) {
+  const int b = sim.scene().find_body(name);
+  EXPECT_GE(b, 0) << name;
+  return sim.world().pose(b).position.z;
+}
+
+// Runs the scene to its end on the CPU backend with 2 threads; checks that
+// every body stays finite and every step converged.
+void run_to_end(Simulation& sim) {
+  sim.advance_to(sim.scene().simulation.duration);
+  sim.finish();
+  for (int b = 0; b < sim.world().body_count(); ++b) EXPECT_TRUE(sim.finite_state(b)) << b;
+  int unconverged = 0;
+  for (const StepRecord& r : sim.records()) unconverged += r.converged ? 0 : 1;
+  EXPECT_EQ(unconverged, 0);
+}
+
+double outcome(const Simulation& sim, const std::string& name) {
+  const auto it = sim.outcomes().find(name);
+  EXPECT_NE(it, sim.outcomes().end()) << "outcome " << name << " missing";
+  return it == sim.outcomes().end() ? -1.0 : it->second;
+}
+
+// The scenes keep the paper's cell counts and time steps (its Table 1:
+// 32 / 191 / 140 / 140 cells, 10 / 10 / 4 / 4 ms), which the benchmarks
+// compare against.
+TEST(ShieldingScenes, CellCountsAndTimeStepsFollowThePaper) {
+  const struct {
+    const char* name;
+    int cells;
+    double dt;
+  } cases[] = {{"wood_plate", 33, 0.01},
+               {"iron_plate", 189, 0.01},
+               {"thin_iron_plate", 140, 0.004},
+               {"thick_iron_plate", 140, 0.004}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const SceneDescription scene = load_scene(scene_path(c.name));
+    Simulation sim(scene, make_cpu_backend(2));
+    EXPECT_EQ(sim.magnetics().model().cell_count(), c.cells);
+    EXPECT_DOUBLE_EQ(scene.simulation.time_step, c.dt);
+  }
+}
+
+// Fig. 13a: wood does not affect the magnetic interaction; the ball is
+// lifted and ends pressed against the underside of the wooden plate.
+TEST(ShieldingScenes, WoodPlateDoesNotStopTheBall) {
+  const SceneDescription scene = load_scene(scene_path("wood_plate"));
+  Simulation sim(scene, make_cpu_backend(2));
+  run_to_end(sim);
+  EXPECT_EQ(outcome(sim, "ball_lifted"), 1.0);
+  const BodyDescription& plate = body(scene, "plate");
+  const double underside = plate.position.z - box_half_height(plate);
+  const double R = sphere_radius(body(scene, "ball"));
+  EXPECT_NEAR(height_of(sim, "ball"), underside - R, 1e-3);
+}
+
+// Fig. 13b: the soft-iron plate shields the ball, which stays on the table
+// (the magnetic pull is below its weight); once the plate is removed the
+// ball is lifted to the magnet.
+TEST(ShieldingScenes, IronPlateShieldsUntilItIsRemoved) {
+  const SceneDescription scene = load_scene(scene_path("iron_plate"));
+  double removal = -1.0;
+  for (const TimelineEvent& e : scene.timeline)
+    if (e.kind == TimelineEvent::Kind::remove_body && e.body == "plate") removal = e.time;
+  ASSERT_GT(removal, 0.0);
+  ASSERT_GT(scene.simulation.duration, removal + 0.5);
+
+  Simulation sim(scene, make_cpu_backend(2));
+  const BodyDescription& ball = body(scene, "ball");
+  const double R = sphere_radius(ball);
+  sim.advance_to(removal - 0.05);
+  EXPECT_NEAR(height_of(sim, "ball"), R, 0.5e-3) << "the ball left the table before the plate was removed";
+  const int b = scene.find_body("ball");
+  const double weight = ball.density * 4.0 / 3.0 * kPi * R * R * R * std::abs(scene.gravity.z);
+  const double pull = sim.magnetics().force(b).z;
+  EXPECT_GT(pull, 0.0);
+  EXPECT_LT(pull, 0.8 * weight) << "the plate no longer shields the ball";
+
+  run_to_end(sim);
+  EXPECT_EQ(outcome(sim, "ball_lifted_before_removal"), 0.0);
+  EXPECT_EQ(outcome(sim, "ball_lifted_after_removal"), 1.0);
+  // At the end the ball touches the magnet's lower face.
+  const BodyDescription& magnet = body(scene, "magnet");
+  const double face = sim.world().pose(scene.find_body("magnet")).position.z - box_half_height(magnet);
+  EXPECT_NEAR(height_of(sim, "ball"), face - R, 1e-3);
+}
+
+// Fig. 15a: the thin plate carries little flux: exactly one ball, the one
+// under the magnet, is lifted (to the plate's underside).
+TEST(ShieldingScenes, ThinIronPlateLetsExactlyOneBallBeLifted) {
+  const SceneDescription scene = load_scene(scene_path("thin_iron_plate"));
+  Simulation sim(scene, make_cpu_backend(2));
+  run_to_end(sim);
+  EXPECT_EQ(outcome(sim, "balls_lifted"), 1.0);
+  const double R = sphere_radius(body(scene, "ball_2"));
+  EXPECT_GT(height_of(sim, "ball_2"), 2.0 * R) << "the ball under the magnet was not the one lifted";
+  EXPECT_NEAR(height_of(sim, "ball_1"), R, 0.5e-3);
+  EXPECT_NEAR(height_of(sim, "ball_3"), R, 0.5e-3);
+}
+
+// Fig. 15b: the thick plate shields all balls.
+TEST(ShieldingScenes, ThickIronPlateLetsNoBallBeLifted) {
+  const SceneDescription scene = load_scene(scene_path("thick_iron_plate"));
+  Simulation sim(scene, make_cpu_backend(2));
+  run_to_end(sim);
+  EXPECT_EQ(outcome(sim, "balls_lifted"), 0.0);
+  for (const char* name : {"ball_1", "ball_2", "ball_3"})
+    EXPECT_NEAR(height_of(sim, name), sphere_radius(body(scene, name)), 0.5e-3) << name;
+}
+
+// Fig. 15: the two scenes differ only in the plate's thickness (same magnet,
+// balls, tray, plate underside and cell lattice), so the outcome is the
+// plate's doing.
+TEST(ShieldingScenes, ThinAndThickScenesDifferOnlyInPlateThickness) {
+  const SceneDescription thin = load_scene(scene_path("thin_iron_plate"));
+  const SceneDescription thick = load_scene(scene_path("thick_iron_plate"));
+  ASSERT_EQ(thin.bodies.size(), thick.bodies.size());
+  for (size_t i = 0; i < thin.bodies.size(); ++i) {
+    const BodyDescription &a = thin.bodies[i], &b = thick.bodies[i];
+    SCOPED_TRACE(a.name);
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.material, b.material);
+    if (a.name == "plate") {
+      const Box& pa = std::get<Box>(a.shape);
+      const Box& pb = std::get<Box>(b.shape);
+      EXPECT_EQ(pa.size.x, pb.size.x);
+      EXPECT_EQ(pa.size.y, pb.size.y);
+      EXPECT_LT(pa.size.z, pb.size.z);
+      EXPECT_NEAR(a.position.z - pa.size.z / 2, b.position.z - pb.size.z / 2, 1e-9);
+      EXPECT_EQ(a.cell_size, b.cell_size);
+    } else {
+      EXPECT_EQ(a.position.x, b.position.x);
+      EXPECT_EQ(a.position.y, b.position.y);
+      EXPECT_EQ(a.position.z, b.position.z);
+    }
+  }
+  EXPECT_EQ(thin.simulation.time_step, thick.simulation.time_step);
+  EXPECT_EQ(thin.simulation.duration, thick.simulation.duration);
+}
+
+}  // namespace
+}  // namespace odemag
