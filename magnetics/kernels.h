@@ -30,20 +30,18 @@ struct DipoleCoefficients {
 };
 
 // s2 = s^2, the squared contact distance; s2 = 0 gives the exact point dipole.
+// Branch-free (it vectorizes): with r_e^2 = max(r^2, s^2) and q = r^2 / r_e^2,
+// the core polynomials below become the dipole coefficients at q = 1, i.e.
+// wherever r >= s: A = -1/(4 pi r^3), B = 3/(4 pi r^5), and C is the same
+// expression in both regions.
 ODEMAG_HD DipoleCoefficients dipole_coefficients(double r2, double s2) {
   const double k = 1.0 / (4.0 * kPi);
-  if (r2 >= s2) {
-    const double inv_r2 = 1.0 / r2;
-    const double inv_r3 = inv_r2 * sqrt(inv_r2);
-    const double inv_r5 = inv_r3 * inv_r2;
-    return {-k * inv_r3, 3.0 * k * inv_r5, -15.0 * k * inv_r5 * inv_r2};
-  }
-  const double inv_s2 = 1.0 / s2;
-  const double inv_s3 = inv_s2 * sqrt(inv_s2);
-  const double inv_s5 = inv_s3 * inv_s2;
-  const double q = r2 * inv_s2;
-  return {k * inv_s3 * (-35.0 / 8.0 + q * (21.0 / 4.0 - q * (15.0 / 8.0))),
-          k * inv_s5 * (21.0 / 2.0 - q * (15.0 / 2.0)), -15.0 * k * inv_s5 * inv_s2};
+  const double inv_r2 = 1.0 / fmax(r2, s2);
+  const double inv_r3 = inv_r2 * sqrt(inv_r2);
+  const double inv_r5 = inv_r3 * inv_r2;
+  const double q = r2 * inv_r2;
+  return {k * inv_r3 * (-35.0 / 8.0 + q * (21.0 / 4.0 - q * (15.0 / 8.0))),
+          k * inv_r5 * (21.0 / 2.0 - q * (15.0 / 2.0)), -15.0 * k * inv_r5 * inv_r2};
 }
 
 // Field H (A/m) at offset r from a moment mu (A m^2): T(r) mu.

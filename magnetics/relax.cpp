@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "magnetics/anderson.h"
 #include "magnetics/kernels.h"
@@ -9,6 +10,10 @@
 namespace odemag {
 
 namespace {
+
+// An Anderson step may move the applied field at most this many times the
+// current (weighted) residual.
+constexpr double kMaxStepPerResidual = 30.0;
 
 std::vector<int> active_responsive_cells(const MagneticModel& model, const MagneticState& state) {
   std::vector<int> cells;
@@ -113,6 +118,7 @@ RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxO
   }
   AndersonMixer mixer(o.anderson_depth, o.mixing);
   mixer.set_weights(weights);
+  double best_residual = std::numeric_limits<double>::infinity();
 
   for (report.iterations = 1; report.iterations <= o.max_iterations; ++report.iterations) {
     for (int i = 0; i < n; ++i) H_A[cells[i]] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
@@ -143,7 +149,29 @@ RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxO
       for (int i = 0; i < n; ++i) H_A[cells[i]] = G[i];
       break;
     }
+    // Safeguarded Anderson step. Hysteretic cells make the map x -> G(x)
+    // path-dependent: an extrapolated field that overshoots can switch cells
+    // irreversibly (measured: a remanent nail demagnetized by one bad
+    // iterate). So a step is capped at 30 times the residual (ill-conditioned
+    // bodies such as needles need steps of ~1/(1 - lambda) = 100 times), and
+    // when the residual grows past 10 times the best seen, the history is
+    // dropped and a damped plain step taken instead.
+    double fw = 0.0;
+    for (int i = 0; i < 3 * n; ++i) fw += weights[i] * weights[i] * f[i] * f[i];
+    fw = std::sqrt(fw);
+    if (fw > 10.0 * best_residual) {
+      mixer.reset();
+      for (int i = 0; i < 3 * n; ++i) x[i] += 0.5 * f[i];
+      continue;
+    }
+    best_residual = std::min(best_residual, fw);
+    const std::vector<double> x_old = x;
     mixer.next(x, f);
+    double dw = 0.0;
+    for (int i = 0; i < 3 * n; ++i) dw += weights[i] * weights[i] * (x[i] - x_old[i]) * (x[i] - x_old[i]);
+    dw = std::sqrt(dw);
+    if (dw > kMaxStepPerResidual * fw)
+      for (int i = 0; i < 3 * n; ++i) x[i] = x_old[i] + (kMaxStepPerResidual * fw / dw) * (x[i] - x_old[i]);
   }
   report.iterations = std::min(report.iterations, o.max_iterations);
   for (int c : cells) state.applied_field[c] = H_A[c];
