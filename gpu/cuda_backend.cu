@@ -398,9 +398,7 @@ class CudaBackend final : public MagneticBackend {
       const Vec3 mi = model.body(b).cells.cell_volume * state.magnetization[all_cells_[i]];
       const Vec3& f = pin_out_[i];
       state.force[b] += f;
-      // tau = (x - c) x F + mu0 mu x (H_other + H_E)  (MODEL.md "Forces and torques").
-      state.torque[b] += cross(xi - state.pose[b].position, f) +
-                         kMu0 * cross(mi, pin_out2_[i] + state.external_field);
+      state.torque[b] += cell_torque(xi - state.pose[b].position, f, mi, pin_out2_[i] + state.external_field);
     }
     timer.stop();
   }

@@ -12,9 +12,6 @@ namespace odemag::gpu {
 
 namespace {
 
-// The noise stream of a cell: hash_key(seed, kNoiseStream, cell, 0), the key
-// the CPU backend uses (magnetics/cpu_backend.cpp), so both draw the same noise.
-constexpr uint64_t kNoiseStream = 0x4e4f495345ULL;  // "NOISE"
 
 __device__ unsigned long long larger(unsigned long long a, unsigned long long b) { return a > b ? a : b; }
 
@@ -31,7 +28,7 @@ __global__ void __launch_bounds__(kThreadsPerBlock) relax_cells_kernel(RelaxCell
       uint64_t counter = a.counter[i];
       const LocalRelaxResult r = relax_soft_cell(
           b.soft, b.rotation.transpose_times(a.applied[i]), a.moments + off, a.hc_prev + off, history,
-          counter, hash_key(a.seed, kNoiseStream, static_cast<uint64_t>(a.cell[i]), 0), a.options);
+          counter, noise_stream(a.seed, static_cast<uint64_t>(a.cell[i])), a.options);
       a.history[i] = history ? 1 : 0;
       a.counter[i] = counter;
       a.magnetization[i] = b.rotation * (b.soft.Ms * mean_moment(a.moments + off, b.soft.n));

@@ -7,6 +7,7 @@
 #include "magnetics/backend.h"
 #include "magnetics/field_probe.h"
 #include "magnetics/kernels.h"
+#include "magnetics/simd.h"
 
 namespace odemag {
 
@@ -43,10 +44,9 @@ struct CellArrays {
 };
 
 // Field at (tx, ty, tz) of sources [j0, j1) through the kernel with contact
-// distance s = target_radius + source radius (overlap_radius < 0: exact dipole).
+// distance target_radius + source radius.
 inline Vec3 sum_field(const CellArrays& s, int j0, int j1, double tx, double ty, double tz,
-                      double target_radius, bool regularised) {
-  double hx = 0, hy = 0, hz = 0;
+                      double target_radius) {
   const double* __restrict x = s.x.data();
   const double* __restrict y = s.y.data();
   const double* __restrict z = s.z.data();
@@ -54,10 +54,29 @@ inline Vec3 sum_field(const CellArrays& s, int j0, int j1, double tx, double ty,
   const double* __restrict mx = s.mx.data();
   const double* __restrict my = s.my.data();
   const double* __restrict mz = s.mz.data();
+#if ODEMAG_HAVE_SIMD8
+  Simd8 hx, hy, hz;
+  for (int j = j0; j < j1; j += 8) {
+    const int count = j1 - j < 8 ? j1 - j : 8;
+    const Simd8 dx = Simd8(tx) - Simd8::load(x + j, count), dy = Simd8(ty) - Simd8::load(y + j, count),
+                dz = Simd8(tz) - Simd8::load(z + j, count);
+    const Simd8 contact = Simd8(target_radius) + Simd8::load(r + j, count);
+    const Simd8 r2 = dx * dx + dy * dy + dz * dz;
+    const DipoleCoefficientsT<Simd8> c = dipole_coefficients_from(r2, inverse_sqrt(max(r2, contact * contact)));
+    const Simd8 ax = Simd8::load(mx + j, count), ay = Simd8::load(my + j, count), az = Simd8::load(mz + j, count);
+    const Simd8 rm = c.B * (dx * ax + dy * ay + dz * az);
+    // Lanes past the end hold zero moments, so they add nothing.
+    hx += c.A * ax + rm * dx;
+    hy += c.A * ay + rm * dy;
+    hz += c.A * az + rm * dz;
+  }
+  return {hx.sum(), hy.sum(), hz.sum()};
+#else
+  double hx = 0, hy = 0, hz = 0;
 #pragma omp simd reduction(+ : hx, hy, hz)
   for (int j = j0; j < j1; ++j) {
     const double dx = tx - x[j], dy = ty - y[j], dz = tz - z[j];
-    const double contact = regularised ? target_radius + r[j] : 0.0;
+    const double contact = target_radius + r[j];
     const DipoleCoefficients c = dipole_coefficients(dx * dx + dy * dy + dz * dz, contact * contact);
     const double rm = c.B * (dx * mx[j] + dy * my[j] + dz * mz[j]);
     hx += c.A * mx[j] + rm * dx;
@@ -65,6 +84,67 @@ inline Vec3 sum_field(const CellArrays& s, int j0, int j1, double tx, double ty,
     hz += c.A * mz[j] + rm * dz;
   }
   return {hx, hy, hz};
+#endif
+}
+
+// Force (N) on, and field (A/m) at, a target cell (position t, moment mt,
+// contact radius rt) from sources [j0, j1), through the kernel with contact
+// distance rt + source radius.
+struct ForceAndField {
+  Vec3 force, field;
+};
+inline ForceAndField sum_force_and_field(const CellArrays& s, int j0, int j1, const Vec3& t, const Vec3& mt,
+                                        double rt) {
+  const double* __restrict x = s.x.data();
+  const double* __restrict y = s.y.data();
+  const double* __restrict z = s.z.data();
+  const double* __restrict r = s.radius.data();
+  const double* __restrict mx = s.mx.data();
+  const double* __restrict my = s.my.data();
+  const double* __restrict mz = s.mz.data();
+  // F = mu0 [B ((r.mu_a) mu_b + (r.mu_b) mu_a + (mu_a.mu_b) r) + C (r.mu_a)(r.mu_b) r]
+  // (magnetics/kernels.h), mu_a the source, mu_b the target.
+#if ODEMAG_HAVE_SIMD8
+  Simd8 fx, fy, fz, hx, hy, hz;
+  const Simd8 bx(mt.x), by(mt.y), bz(mt.z);
+  for (int j = j0; j < j1; j += 8) {
+    const int count = j1 - j < 8 ? j1 - j : 8;
+    const Simd8 dx = Simd8(t.x) - Simd8::load(x + j, count), dy = Simd8(t.y) - Simd8::load(y + j, count),
+                dz = Simd8(t.z) - Simd8::load(z + j, count);
+    const Simd8 contact = Simd8(rt) + Simd8::load(r + j, count);
+    const Simd8 r2 = dx * dx + dy * dy + dz * dz;
+    const DipoleCoefficientsT<Simd8> c = dipole_coefficients_from(r2, inverse_sqrt(max(r2, contact * contact)));
+    const Simd8 ax = Simd8::load(mx + j, count), ay = Simd8::load(my + j, count), az = Simd8::load(mz + j, count);
+    const Simd8 ra = dx * ax + dy * ay + dz * az, rb = dx * bx + dy * by + dz * bz;
+    const Simd8 radial = c.B * (ax * bx + ay * by + az * bz) + c.C * ra * rb;
+    fx += c.B * (ra * bx + rb * ax) + radial * dx;
+    fy += c.B * (ra * by + rb * ay) + radial * dy;
+    fz += c.B * (ra * bz + rb * az) + radial * dz;
+    const Simd8 rm = c.B * ra;
+    hx += c.A * ax + rm * dx;
+    hy += c.A * ay + rm * dy;
+    hz += c.A * az + rm * dz;
+  }
+  return {kMu0 * Vec3{fx.sum(), fy.sum(), fz.sum()}, {hx.sum(), hy.sum(), hz.sum()}};
+#else
+  double fx = 0, fy = 0, fz = 0, hx = 0, hy = 0, hz = 0;
+#pragma omp simd reduction(+ : fx, fy, fz, hx, hy, hz)
+  for (int j = j0; j < j1; ++j) {
+    const double dx = t.x - x[j], dy = t.y - y[j], dz = t.z - z[j];
+    const double contact = rt + r[j];
+    const DipoleCoefficients c = dipole_coefficients(dx * dx + dy * dy + dz * dz, contact * contact);
+    const double ra = dx * mx[j] + dy * my[j] + dz * mz[j];
+    const double rb = dx * mt.x + dy * mt.y + dz * mt.z;
+    const double radial = c.B * (mx[j] * mt.x + my[j] * mt.y + mz[j] * mt.z) + c.C * ra * rb;
+    fx += c.B * (ra * mt.x + rb * mx[j]) + radial * dx;
+    fy += c.B * (ra * mt.y + rb * my[j]) + radial * dy;
+    fz += c.B * (ra * mt.z + rb * mz[j]) + radial * dz;
+    hx += c.A * mx[j] + c.B * ra * dx;
+    hy += c.A * my[j] + c.B * ra * dy;
+    hz += c.A * mz[j] + c.B * ra * dz;
+  }
+  return {kMu0 * Vec3{fx, fy, fz}, {hx, hy, hz}};
+#endif
 }
 
 class CpuBackend final : public MagneticBackend {
@@ -78,10 +158,11 @@ class CpuBackend final : public MagneticBackend {
     resp_.clear();
     all_.clear();
     resp_range_.clear();
+    all_range_.clear();
     for (int b = 0; b < model.body_count(); ++b) {
       const MagneticBody& body = model.body(b);
       if (body.inert() || !state.active[b]) continue;
-      const int begin = resp_.size();
+      const int begin = resp_.size(), all_begin = all_.size();
       for (int i = 0; i < body.cell_count(); ++i) {
         const int c = body.first_cell + i;
         all_.push(model, state, c);
@@ -92,6 +173,7 @@ class CpuBackend final : public MagneticBackend {
         }
       }
       for (int i = begin; i < resp_.size(); ++i) resp_range_.push_back({begin, resp_.size()});
+      for (int i = all_begin; i < all_.size(); ++i) all_range_.push_back({all_begin, all_.size()});
     }
     fixed_.load_moments(model, state);
   }
@@ -102,7 +184,7 @@ class CpuBackend final : public MagneticBackend {
     for (int i = 0; i < n; ++i)
       H[resp_.cell[i]] = state.external_field +
                          sum_field(fixed_, 0, fixed_.size(), resp_.x[i], resp_.y[i], resp_.z[i],
-                                   resp_.radius[i], true);
+                                   resp_.radius[i]);
   }
 
   void responsive_field(const MagneticModel& model, const MagneticState& state,
@@ -118,8 +200,8 @@ class CpuBackend final : public MagneticBackend {
     for (int i = 0; i < n; ++i) {
       const auto [begin, end] = resp_range_[i];
       // Inter-body: every responsive cell of another body.
-      Vec3 h = sum_field(resp_, 0, begin, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i], true) +
-               sum_field(resp_, end, n, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i], true);
+      Vec3 h = sum_field(resp_, 0, begin, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]) +
+               sum_field(resp_, end, n, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]);
       // Intra-body: cached tensors of the body, in the body frame.
       const MagneticBody& body = model.body(resp_.body[i]);
       if (end - begin > 1) {
@@ -156,7 +238,7 @@ class CpuBackend final : public MagneticBackend {
       bool history = state.llg_history[c] != 0;
       const LocalRelaxResult r = relax_soft_cell(
           body.soft, R.transpose_times(H_A[c]), &state.moments[off], &state.moment_hc_prev[off],
-          history, state.noise_counter[c], hash_key(state.seed, 0x4e4f495345ULL, c, 0), options);
+          history, state.noise_counter[c], noise_stream(state.seed, c), options);
       state.llg_history[c] = history ? 1 : 0;
       state.magnetization[c] = R * (body.soft.Ms * mean_moment(&state.moments[off], body.soft.n));
       llg += r.llg_steps;
@@ -173,18 +255,13 @@ class CpuBackend final : public MagneticBackend {
     cell_field_.assign(n, {});
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads_) if (static_cast<long>(n) * n > kParallelPairs)
     for (int i = 0; i < n; ++i) {
+      // Every cell of another body (pairs inside a body cancel).
       const Vec3 xi{all_.x[i], all_.y[i], all_.z[i]}, mi{all_.mx[i], all_.my[i], all_.mz[i]};
-      Vec3 f, h;
-      for (int j = 0; j < n; ++j) {
-        if (all_.body[j] == all_.body[i]) continue;  // pairs inside a body cancel
-        const Vec3 r = xi - Vec3{all_.x[j], all_.y[j], all_.z[j]};
-        const Vec3 mj{all_.mx[j], all_.my[j], all_.mz[j]};
-        const double s = all_.radius[i] + all_.radius[j];
-        f += dipole_force(r, mj, mi, s * s);
-        h += dipole_field(r, mj, s * s);
-      }
-      cell_force_[i] = f;
-      cell_field_[i] = h;
+      const auto [begin, end] = all_range_[i];
+      const ForceAndField a = sum_force_and_field(all_, 0, begin, xi, mi, all_.radius[i]);
+      const ForceAndField b = sum_force_and_field(all_, end, n, xi, mi, all_.radius[i]);
+      cell_force_[i] = a.force + b.force;
+      cell_field_[i] = a.field + b.field;
     }
     std::fill(state.force.begin(), state.force.end(), Vec3{});
     std::fill(state.torque.begin(), state.torque.end(), Vec3{});
@@ -192,9 +269,8 @@ class CpuBackend final : public MagneticBackend {
       const int b = all_.body[i];
       const Vec3 xi{all_.x[i], all_.y[i], all_.z[i]}, mi{all_.mx[i], all_.my[i], all_.mz[i]};
       state.force[b] += cell_force_[i];
-      // tau = (x - c) x F + mu0 mu x (H_other + H_E)  (MODEL.md "Forces and torques").
-      state.torque[b] += cross(xi - state.pose[b].position, cell_force_[i]) +
-                         kMu0 * cross(mi, cell_field_[i] + state.external_field);
+      state.torque[b] += cell_torque(xi - state.pose[b].position, cell_force_[i], mi,
+                                     cell_field_[i] + state.external_field);
     }
   }
 
@@ -215,6 +291,7 @@ class CpuBackend final : public MagneticBackend {
   int threads_;
   CellArrays fixed_, resp_, all_;
   std::vector<std::pair<int, int>> resp_range_;  // per responsive cell: its body's range in resp_
+  std::vector<std::pair<int, int>> all_range_;   // per cell: its body's range in all_
   std::vector<Vec3> body_moment_, cell_force_, cell_field_;
 };
 

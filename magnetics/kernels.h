@@ -23,25 +23,33 @@
 
 namespace odemag {
 
-struct DipoleCoefficients {
-  double A;  // isotropic part of T
-  double B;  // r r^T part of T
-  double C;  // B'(r) / r, for the force
+template <class T>
+struct DipoleCoefficientsT {
+  T A;  // isotropic part of T
+  T B;  // r r^T part of T
+  T C;  // B'(r) / r, for the force
 };
+using DipoleCoefficients = DipoleCoefficientsT<double>;
+
+// The coefficients from r^2 and inv_r = 1 / r_e, r_e^2 = max(r^2, s^2): with
+// q = r^2 / r_e^2 the core polynomials become the dipole coefficients at q = 1,
+// i.e. wherever r >= s: A = -1/(4 pi r^3), B = 3/(4 pi r^5), and C is the same
+// expression in both regions. Branch-free, for scalars and SIMD vectors alike
+// (magnetics/simd.h).
+template <class T>
+ODEMAG_HD DipoleCoefficientsT<T> dipole_coefficients_from(const T& r2, const T& inv_r) {
+  const double k = 1.0 / (4.0 * kPi);
+  const T inv_r2 = inv_r * inv_r;
+  const T inv_r3 = inv_r2 * inv_r;
+  const T inv_r5 = inv_r3 * inv_r2;
+  const T q = r2 * inv_r2;
+  return {(k * inv_r3) * (T(-35.0 / 8.0) + q * (T(21.0 / 4.0) - q * T(15.0 / 8.0))),
+          (k * inv_r5) * (T(21.0 / 2.0) - q * T(15.0 / 2.0)), (-15.0 * k) * (inv_r5 * inv_r2)};
+}
 
 // s2 = s^2, the squared contact distance; s2 = 0 gives the exact point dipole.
-// Branch-free (it vectorizes): with r_e^2 = max(r^2, s^2) and q = r^2 / r_e^2,
-// the core polynomials below become the dipole coefficients at q = 1, i.e.
-// wherever r >= s: A = -1/(4 pi r^3), B = 3/(4 pi r^5), and C is the same
-// expression in both regions.
 ODEMAG_HD DipoleCoefficients dipole_coefficients(double r2, double s2) {
-  const double k = 1.0 / (4.0 * kPi);
-  const double inv_r2 = 1.0 / fmax(r2, s2);
-  const double inv_r3 = inv_r2 * sqrt(inv_r2);
-  const double inv_r5 = inv_r3 * inv_r2;
-  const double q = r2 * inv_r2;
-  return {k * inv_r3 * (-35.0 / 8.0 + q * (21.0 / 4.0 - q * (15.0 / 8.0))),
-          k * inv_r5 * (21.0 / 2.0 - q * (15.0 / 2.0)), -15.0 * k * inv_r5 * inv_r2};
+  return dipole_coefficients_from(r2, 1.0 / sqrt(r2 > s2 ? r2 : s2));
 }
 
 // Field H (A/m) at offset r from a moment mu (A m^2): T(r) mu.
@@ -55,6 +63,13 @@ ODEMAG_HD Vec3 dipole_force(const Vec3& r, const Vec3& mu_a, const Vec3& mu_b, d
   const DipoleCoefficients c = dipole_coefficients(dot(r, r), s2);
   const double ra = dot(r, mu_a), rb = dot(r, mu_b);
   return kMu0 * (c.B * (ra * mu_b + rb * mu_a + dot(mu_a, mu_b) * r) + (c.C * ra * rb) * r);
+}
+
+// Torque (N m) about a body's centre of mass of one of its cells at offset
+// r_from_centre, with force F on it, moment mu and field H there from the
+// other bodies and H_E: tau = r x F + mu0 mu x H (MODEL.md).
+ODEMAG_HD Vec3 cell_torque(const Vec3& r_from_centre, const Vec3& F, const Vec3& mu, const Vec3& H) {
+  return cross(r_from_centre, F) + kMu0 * cross(mu, H);
 }
 
 // Interaction energy (J) of the pair: U = -mu0 mu_b . T(r) mu_a.

@@ -300,6 +300,12 @@ ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, i
 
 // ---- the inner relaxation of one cell -----------------------------------------
 
+// The noise stream of a cell: its draws are hash(stream ^ counter), so they
+// depend on the seed, the cell and how many steps it took, nothing else.
+ODEMAG_HD uint64_t noise_stream(uint64_t seed, uint64_t cell) {
+  return hash_key(seed, 0x4e4f495345ULL, cell, 0);
+}
+
 // Relax the moments of one soft cell under the frozen applied field H_A.
 // single_step: one LLG step with history (paper Algorithm 1, one iteration).
 // Otherwise: LLG steps until the relative torque falls below llg_switch (these
