@@ -26,7 +26,7 @@ struct Heap {
     steel.saturation = 1.6e6;
     steel.susceptibility = 1000;
     const double side = 0.011 * std::cbrt(static_cast<double>(n));
-    for (int i = 0; i < n; ++i) model.add_body("b" + std::to_string(i), Sphere{0.005}, steel, 0.0);
+    for (int i = 0; i < n; ++i) model.add_body(std::to_string(i), Sphere{0.005}, steel, 0.0);
     state = make_state(model, 5);
     for (int i = 0; i < n; ++i) {
       state.pose[i].position = side * Vec3{unit_interval(hash_key(1, i, 0, 0)), unit_interval(hash_key(1, i, 1, 0)),

@@ -172,12 +172,10 @@ ODEMAG_HD double cell_torque_residual(const SoftCellParams& p, const Vec3& H_A, 
 
 // ---- Newton polish ------------------------------------------------------------
 
-// Rotate m by the tangent vector d (exponential map on the unit sphere).
-ODEMAG_HD Vec3 rotate_on_sphere(const Vec3& m, const Vec3& d) {
-  const double t = norm(d);
-  if (t == 0.0) return m;
-  return normalized(cos(t) * m + (sin(t) / t) * d);
-}
+// Move m by the tangent vector d and back onto the unit sphere (the
+// projection retraction: first order like the exponential map, without sin
+// and cos; Newton converges quadratically with either).
+ODEMAG_HD Vec3 rotate_on_sphere(const Vec3& m, const Vec3& d) { return normalized(m + d); }
 
 // Two unit vectors spanning the tangent plane at m.
 ODEMAG_HD void tangent_basis(const Vec3& m, Vec3& u, Vec3& v) {
@@ -208,6 +206,16 @@ ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, i
   const double inv_n = 1.0 / n;
   int steps = 0;
   residual = cell_torque_residual(p, H_A, m);
+  if (residual <= tolerance) {
+    // Converged already. A saddle needs a negative diagonal (m_k . H_eff,k)
+    // in the Hessian (its other parts are positive semi-definite), so only
+    // then is the Hessian worth building.
+    const Vec3 mean_m = mean_moment(m, n);
+    bool saddle_possible = false;
+    for (int k = 0; k < n; ++k)
+      saddle_possible = saddle_possible || dot(m[k], effective_field(p, H_A, mean_m, m[k])) < 0.0;
+    if (!saddle_possible) return 0;
+  }
   for (; steps < max_steps; ++steps) {
     const Vec3 mean_m = mean_moment(m, n);
     const double scale = torque_scale(p, H_A, mean_m);

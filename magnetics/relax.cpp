@@ -119,9 +119,14 @@ RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxO
   AndersonMixer mixer(o.anderson_depth, o.mixing);
   mixer.set_weights(weights);
   double best_residual = std::numeric_limits<double>::infinity();
+  int last_progress = 0;  // iteration of the last halving of the best residual
 
   for (report.iterations = 1; report.iterations <= o.max_iterations; ++report.iterations) {
     for (int i = 0; i < n; ++i) H_A[cells[i]] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+    // Inexact inner solves: each cell only as accurately as the outer loop
+    // can use now (1% of its last residual), down to the inner tolerance.
+    if (!report.residual_history.empty())
+      local.tolerance = std::max(o.local.tolerance, std::min(1e-6, 1e-2 * report.residual_history.back()));
     const LocalStats s = backend.relax_cells(model, state, H_A, local);
     report.llg_steps += s.llg_steps;
     report.newton_steps += s.newton_steps;
@@ -163,6 +168,16 @@ RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxO
       mixer.reset();
       for (int i = 0; i < 3 * n; ++i) x[i] += 0.5 * f[i];
       continue;
+    }
+    // Stagnation (cells switching across a hysteresis jump make x -> G(x)
+    // discontinuous, and the stored differences then describe the other
+    // branch): if the best residual has not halved in 20 iterations, the
+    // history is dropped.
+    if (fw < 0.5 * best_residual) {
+      last_progress = report.iterations;
+    } else if (report.iterations - last_progress >= 20) {
+      mixer.reset();
+      last_progress = report.iterations;
     }
     best_residual = std::min(best_residual, fw);
     const std::vector<double> x_old = x;
