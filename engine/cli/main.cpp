@@ -10,6 +10,9 @@
 #include <vector>
 
 #include "engine/cli/cli.h"
+#ifdef ODEMAG_WITH_RENDERER
+#include "demos/view/scene_view.h"
+#endif
 #include "engine/scene.h"
 
 namespace {
@@ -28,7 +31,13 @@ int dispatch(const std::string& command, const std::vector<std::string>& args) {
   }
   if (command == "solve") return odemag::cli::run_solve(args);
   if (command == "field") return odemag::cli::run_field(args);
-  if (command == "run") return odemag::cli::run_simulation(args, odemag::cli::FrameWriterFactory{});
+  if (command == "run") {
+#ifdef ODEMAG_WITH_RENDERER
+    return odemag::cli::run_simulation(args, odemag::make_png_frame_writer);
+#else
+    return odemag::cli::run_simulation(args, odemag::cli::FrameWriterFactory{});
+#endif
+  }
   throw odemag::cli::UsageError("unknown command '" + command + "' (commands: solve, field, run, help)");
 }
 
