@@ -284,7 +284,7 @@ class SceneReader {
 std::string material_message_key(const std::string& message) {
   for (std::string_view key : {"magnetization", "recoil_susceptibility", "saturation",
                                "susceptibility", "anisotropy_field", "easy_axis", "damping",
-                               "moments_per_cell"})
+                               "moments_per_cell", "coil_field"})
     if (message.rfind(std::string(key) + " ", 0) == 0) return std::string(key);
   return {};
 }
@@ -304,7 +304,7 @@ Material read_material(const SceneReader& r, const json& v, const std::string& p
     material = m;
   } else if (type == "soft") {
     r.check_keys(v, path, {"type", "saturation", "susceptibility", "anisotropy_field", "easy_axis",
-                           "damping", "moments_per_cell", "color"});
+                           "damping", "moments_per_cell", "coil_field", "color"});
     SoftMaterial m;
     m.saturation = r.positive(r.required(v, "saturation", path), member(path, "saturation"));
     r.optional(v, "susceptibility", path, [&](const json& x, const std::string& p) {
@@ -329,6 +329,7 @@ Material read_material(const SceneReader& r, const json& v, const std::string& p
                       ", got " + std::to_string(n));
       m.moments_per_cell = n;
     });
+    r.optional(v, "coil_field", path, [&](const json& x, const std::string& p) { m.coil_field = r.vec3(x, p); });
     material = m;
   } else {
     r.check_keys(v, path, {"type", "color"});
@@ -575,8 +576,12 @@ TimelineEvent read_event(const SceneReader& r, const json& v, const std::string&
     read_time();
     e.body = event_body(r, v, path, scene);
     const BodyDescription& body = scene.bodies[static_cast<size_t>(scene.find_body(e.body))];
-    if (!std::holds_alternative<PermanentMaterial>(scene.materials.at(body.material)))
-      r.fail(member(path, "body"), "body " + as_literal(e.body) + " is not a permanent magnet (material " +
+    const Material& material = scene.materials.at(body.material);
+    const SoftMaterial* soft = std::get_if<SoftMaterial>(&material);
+    const bool electromagnet = soft && norm(soft->coil_field) > 0.0;
+    if (!std::holds_alternative<PermanentMaterial>(material) && !electromagnet)
+      r.fail(member(path, "body"), "body " + as_literal(e.body) +
+                                       " is neither a permanent magnet nor an electromagnet (material " +
                                        as_literal(body.material) + ")");
     e.value = r.number(r.required(v, "to", path), member(path, "to"));
     e.end_time = event_end_time(r, v, path, e.time);

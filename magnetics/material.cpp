@@ -35,6 +35,7 @@ std::string validate_one(const SoftMaterial& m) {
   if (!finite(m.easy_axis) || norm(m.easy_axis) == 0.0)
     return "easy_axis must be a finite non-zero vector";
   if (!std::isfinite(m.damping) || m.damping <= 0.0) return "damping must be finite and > 0";
+  if (!finite(m.coil_field)) return "coil_field must be finite";
   if (m.moments_per_cell < 2 || m.moments_per_cell > kMaxMomentsPerCell ||
       m.moments_per_cell % 2 != 0)
     return "moments_per_cell must be an even number from 2 to " +

@@ -25,6 +25,12 @@ struct SoftMaterial {
   Vec3 easy_axis{0.0, 0.0, 1.0};                                    // body frame, normalised on use
   double damping = 1.0;                                             // Gilbert alpha, > 0
   int moments_per_cell = 2;                                         // n, even, 2..kMaxMomentsPerCell
+  // An electromagnet: the field of its coil inside the core (A/m, body
+  // frame), added to the applied field of the body's own cells and scaled
+  // like a permanent magnet's remanence (time-line scale_magnetization).
+  // The coil's own field outside the core is neglected: the magnetized
+  // core's is what acts on other bodies.
+  Vec3 coil_field;
 
   // Demagnetising factor of a spherical cell including the intrinsic
   // susceptibility: gamma_D = 1/3 + 1/chi (MODEL.md, H_endo).

@@ -65,6 +65,7 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     body.soft.easy_axis = normalized(sm->easy_axis);
     body.soft.alpha = sm->damping;
     body.soft.n = sm->moments_per_cell;
+    body.coil_field = sm->coil_field;
   }
   if (body.responsive() && body.cell_count() > 1) build_offset_tensors(body, intra_tensor_);
 

@@ -32,6 +32,7 @@ struct MagneticBody {
   CellKind kind = CellKind::fixed_permanent;
   SoftCellParams soft;   // for soft bodies (easy axis normalised, body frame)
   Vec3 remanence;        // M_r for permanent bodies, body frame
+  Vec3 coil_field;       // coil field of an electromagnet's core (soft bodies), body frame
   double recoil = 0.0;   // chi_r for permanent bodies
 
   // Intra-body interaction tensors, computed once per body: H = T(d) mu for

@@ -63,6 +63,17 @@ RelaxReport relax_paper(const MagneticModel& model, MagneticState& state, const 
   return report;
 }
 
+// Electromagnets: the (scaled) coil field acts on the cells of its own core.
+void add_coil_fields(const MagneticModel& model, const MagneticState& state, const std::vector<int>& cells,
+                     std::vector<Vec3>& H) {
+  for (int c : cells) {
+    const int b = model.cell_body(c);
+    const Vec3& coil = model.body(b).coil_field;
+    if (coil.x != 0.0 || coil.y != 0.0 || coil.z != 0.0)
+      H[c] += state.pose[b].rotation * (state.magnetization_scale[b] * coil);
+  }
+}
+
 }  // namespace
 
 RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
@@ -78,6 +89,7 @@ RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxO
 
   std::vector<Vec3> H_fixed(model.cell_count());
   backend.fixed_field(model, state, H_fixed);
+  add_coil_fields(model, state, cells, H_fixed);
   if (o.scheme == RelaxScheme::paper) return relax_paper(model, state, o, backend, cells, H_fixed);
 
   RelaxReport report;

@@ -347,6 +347,37 @@ TEST(FieldProbe, InsideMagnetsGivesTheUniformSolidsField) {
   }
 }
 
+// An electromagnet: a soft core driven by its coil field H_c (body frame)
+// is magnetized as a sphere in a uniform H_c would be (one cell: M = H_c /
+// gamma_D below saturation), the field turns with the body, scales with the
+// body's magnetization scale, and acts on the core only: a soft ball nearby
+// feels just the core's dipole field.
+TEST(Electromagnet, CoilFieldMagnetizesItsOwnCoreOnly) {
+  const double R = 0.01, chi = 1000.0, Ms = 1.7e6;
+  SoftMaterial core;
+  core.saturation = Ms;
+  core.susceptibility = chi;
+  core.coil_field = {0, 0, 2e5};
+  SoftMaterial ball = core;
+  ball.coil_field = {};
+  Scene s;
+  s.model.add_body("core", Sphere{R}, core, 0.0);
+  s.model.add_body("ball", Sphere{0.002}, ball, 0.0);
+  s.init(tilted(), {});
+  s.state.pose[1].position = {0.3, 0, 0};  // far: it feels ~0 from the core
+  s.relax_in({}, tight());
+  const double gamma_D = 1.0 / 3.0 + 1.0 / chi;
+  const Vec3 expected = (2e5 / gamma_D) * (tilted() * Vec3{0, 0, 1});
+  EXPECT_LT(rel(s.state.magnetization[0], expected), 1e-9);
+  // The ball feels the core's dipole field only: M = 3 R^3 ... tiny, not 2e5 / gamma_D.
+  const Vec3 mu = (4.0 / 3.0 * ref::kRefPi * R * R * R) * s.state.magnetization[0];
+  const Vec3 dipole = ref::point_dipole_H(mu, {0.3, 0, 0});
+  EXPECT_LT(rel(s.state.applied_field[1], dipole), 1e-9);
+  s.state.magnetization_scale[0] = 0.25;
+  s.relax_in({}, tight());
+  EXPECT_LT(rel(s.state.magnetization[0], 0.25 * expected), 1e-9);
+}
+
 // 4. A one-cell soft sphere in a uniform field: M = chi H_in, H_in = H0 - M/3,
 // so moment 4 pi R^3 chi / (chi + 3) H0 below saturation and (4/3) pi R^3 Ms
 // above (tolerance 1e-6 relative; two-level scheme, tolerance 1e-10).
