@@ -180,17 +180,26 @@ RunResult run(const Dataset& d, const Variant& v, double h, const RelaxOptions& 
     model.add_body("cuboid" + std::to_string(i), Box{c.size}, material, h);
     cuboid_of_body.push_back(static_cast<int>(i));
   }
-  MagneticState state = make_state(model, 1);
-  for (int b = 0; b < model.body_count(); ++b) {
-    const Cuboid& c = d.cuboids[cuboid_of_body[b]];
-    state.pose[b].rotation = c.rotation;
-    state.pose[b].position = c.position;
-  }
   RunResult r;
   r.cells = model.cell_count();
-  auto t0 = std::chrono::steady_clock::now();
-  r.report = relax(model, state, options, backend);
-  r.relax_s = seconds_since(t0);
+  // Cold relaxations from the same start, repeated while they take less than
+  // 0.5 s in all (at most 5): the best time.
+  MagneticState state;
+  double spent = 0.0;
+  r.relax_s = 1e300;
+  for (int rep = 0; rep < 5 && (rep == 0 || spent < 0.5); ++rep) {
+    state = make_state(model, 1);
+    for (int b = 0; b < model.body_count(); ++b) {
+      const Cuboid& c = d.cuboids[cuboid_of_body[b]];
+      state.pose[b].rotation = c.rotation;
+      state.pose[b].position = c.position;
+    }
+    const auto t_rep = std::chrono::steady_clock::now();
+    r.report = relax(model, state, options, backend);
+    const double t = seconds_since(t_rep);
+    r.relax_s = std::min(r.relax_s, t);
+    spent += t;
+  }
   for (int b = 0; b < model.body_count(); ++b) {
     if (!d.cuboids[cuboid_of_body[b]].soft()) continue;
     const MagneticBody& body = model.body(b);
@@ -198,7 +207,7 @@ RunResult run(const Dataset& d, const Variant& v, double h, const RelaxOptions& 
       r.max_M_soft = std::max(r.max_M_soft, norm(state.magnetization[body.first_cell + i]));
   }
 
-  t0 = std::chrono::steady_clock::now();
+  const auto t0 = std::chrono::steady_clock::now();
   double num_all = 0.0, den_all = 0.0;
   for (const SensorLine& s : d.lines) {
     std::vector<Vec3> B, H;
@@ -316,7 +325,7 @@ int main(int argc, char** argv) {
         }
         RunResult r = run(d, v, h, options, *backend);
         r.k = k;
-        std::printf("%s,%s,%d,%.6g,%d,%d,%d,%.3g,%.4f,%.4f", d.name.c_str(), v.name.c_str(), k, 1e3 * h,
+        std::printf("%s,%s,%d,%.6g,%d,%d,%d,%.3g,%.4g,%.4g", d.name.c_str(), v.name.c_str(), k, 1e3 * h,
                     r.cells, r.report.iterations, r.report.converged ? 1 : 0, r.report.residual, r.relax_s,
                     r.probe_s);
         for (size_t l = 0; l < 3; ++l) {

@@ -15,6 +15,7 @@
 //
 // CSV on stdout, one row per run:
 //   study,case,param_name,param,h_mm,cells,iterations,converged,seconds,error_max,error_rms
+// Times are the best of up to 5 repetitions (while they take < 0.5 s in all).
 // sphere: error_max = |m - m_ref| / |m_ref| (total moment), error_rms =
 //         relative RMS error of the induced field (H - H0, field_at_points)
 //         on a sphere of radius 1.5 R (128 points) against the exact dipole
@@ -71,14 +72,23 @@ void sphere_study(MagneticBackend& backend) {
       s.susceptibility = chi;
       MagneticModel model;
       model.add_body("sphere", Sphere{R}, s, k == 0 ? 0.0 : R / k);
-      MagneticState state = make_state(model, 1);
-      state.external_field = H0;
       RelaxOptions o;
       o.tolerance = 1e-8;
       o.max_iterations = 2000;
-      const auto t0 = std::chrono::steady_clock::now();
-      const RelaxReport r = relax(model, state, o, backend);
-      const double t = seconds_since(t0);
+      // Cold relaxations, repeated while they take less than 0.5 s in all
+      // (at most 5): the best time.
+      MagneticState state;
+      RelaxReport r;
+      double t = 1e300, spent = 0.0;
+      for (int rep = 0; rep < 5 && (rep == 0 || spent < 0.5); ++rep) {
+        state = make_state(model, 1);
+        state.external_field = H0;
+        const auto t0 = std::chrono::steady_clock::now();
+        r = relax(model, state, o, backend);
+        const double dt = seconds_since(t0);
+        t = std::min(t, dt);
+        spent += dt;
+      }
       const Vec3 m = body_moment(model, state, 0);
       // Exterior field on a sphere of radius 1.5 R: exact = the dipole m_ref.
       std::vector<Vec3> points, B, H;
@@ -263,6 +273,16 @@ void crane_study(MagneticBackend& backend) {
   double fmax = 0.0;
   for (const Vec3& f : cold_ref.force) fmax = std::max(fmax, norm(f));
   std::fprintf(stderr, "crane: largest force %.4g N, magnet force %.4g N\n", fmax, norm(cold_ref.force[0]));
+  int saturated = 0;
+  double m_min = 1e300;
+  for (int c = 1; c < model.cell_count(); ++c) {
+    if (model.body(model.cell_body(c)).kind != CellKind::soft) continue;
+    const double m = norm(cold_ref.magnetization[c]) / 1.6e6;
+    saturated += m > 0.95 ? 1 : 0;
+    m_min = std::min(m_min, m);
+  }
+  std::fprintf(stderr, "crane: %d of %d balls at |M| > 0.95 Ms, smallest |M| / Ms = %.3f\n", saturated,
+               model.body_count() - 1, m_min);
 
   for (const char* start : {"cold", "warm"}) {
     const bool warm = start[0] == 'w';
