@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <variant>
 
 #include "engine/magnetic_scene.h"
+#include "magnetics/constants.h"
 
 namespace odemag {
 
@@ -77,9 +80,20 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
   }
   magnetics_->set_external_field(scene_.external_field);
   world_->add_accumulator(magnetics_.get());
-  for (const BodyDescription& d : scene_.bodies) {
-    const Vec3 half = shape_half_extents(d.shape);
+  for (size_t b = 0; b < scene_.bodies.size(); ++b) {
+    const Vec3 half = shape_half_extents(scene_.bodies[b].shape);
     body_size_.push_back(std::min({half.x, half.y, half.z}));
+    // A sphere's surface does not move when it turns about its centre.
+    body_reach_.push_back(std::holds_alternative<Sphere>(scene_.bodies[b].shape) ? 0.0
+                                                                                 : norm(half));
+    dMass mass;  // body-frame inertia: diagonal for the centred, axis-aligned shapes
+    dBodyGetMass(world_->body(static_cast<int>(b)), &mass);
+    body_inertia_.push_back(std::min({mass.I[0], mass.I[5], mass.I[10]}));
+    // A uniform field turns every magnetic body but an isotropic one-cell
+    // soft body (a plain iron ball), whose moment simply follows the field.
+    const MagneticBody& mb = magnetics_->model().body(static_cast<int>(b));
+    body_turns_in_field_.push_back(
+        !mb.inert() && !(mb.kind == CellKind::soft && mb.cell_count() == 1 && mb.soft.H_K == 0.0));
   }
   event_state_.assign(scene_.timeline.size(), kPending);
   ramp_start_scale_.assign(scene_.timeline.size(), 1.0);
@@ -132,29 +146,71 @@ void Simulation::apply_timeline(double dt) {
 }
 
 int Simulation::substeps_needed(double dt) const {
-  const int cap = std::max(1, scene_.simulation.max_substeps);
   double shortest = dt;  // longest admissible substep
   for (int b = 0; b < world_->body_count(); ++b) {
     if (world_->kinematic(b) || !world_->enabled(b)) continue;
     const double f = norm(magnetics_->force(b)), m = world_->mass(b), size = body_size_[b];
-    // Collision: the travel v h + a h^2 / 2 in one substep, at the current
-    // velocity and the full acceleration of gravity and magnetic force, at
-    // most L: a tenth of the body's size, three tenths for a body that was in
+    const double reach = body_reach_[b], inertia = body_inertia_[b];
+    // Rotational stiffness: |tau| for the torque of the other bodies (it
+    // turns a body about an orientation of equilibrium), and mu0 |m| |H_E|
+    // for the uniform field, whose torque vanishes at equilibrium while its
+    // stiffness does not (docs/hard-cases.md "Substeps").
+    double k_rot = norm(magnetics_->torque(b));
+    if (body_turns_in_field_[b])
+      k_rot += kMu0 * norm(magnetics_->moment(b)) * norm(magnetics_->external_field());
+    // Collision: the travel v h + a h^2 / 2 in one substep of the body's
+    // farthest point, at the current velocity (translation plus rotation
+    // times the bounding radius) and the full acceleration (gravity, magnetic
+    // force, and the angular acceleration times the bounding radius), at most
+    // L: a tenth of the body's size, three tenths for a body that was in
     // contact (which most likely still holds it; it may have lifted off by a
     // hair, so its acceleration still counts). Solved for h.
-    const double v = norm(world_->velocity(b)), a = f / m + norm(scene_.gravity);
+    const double v = norm(world_->velocity(b)) + norm(world_->angular_velocity(b)) * reach;
+    const double a = f / m + norm(scene_.gravity) +
+                     (inertia > 0.0 ? norm(magnetics_->torque(b)) / inertia * reach : 0.0);
     const double L = (world_->in_contact(b) ? 0.3 : 0.1) * size;
     shortest = std::min(shortest, 2.0 * L / (v + std::sqrt(v * v + 2.0 * a * L)));
     // Time scale of the magnetic force: it varies over distances of the
     // body's size, so it oscillates a body about an equilibrium at
-    // omega^2 ~ |F| / (m size); the explicit update needs omega h <= limit.
+    // omega^2 ~ |F| / (m size); and the torque about an orientation at
+    // omega^2 ~ k_rot / I. The explicit update needs omega h <= limit.
     if (f > 0.0) shortest = std::min(shortest, scene_.simulation.stiffness_limit / std::sqrt(f / (m * size)));
+    if (k_rot > 0.0 && inertia > 0.0)
+      shortest = std::min(shortest, scene_.simulation.stiffness_limit / std::sqrt(k_rot / inertia));
   }
   const double k = std::ceil(dt / shortest * (1.0 - 1e-12));
-  return std::isfinite(k) ? std::clamp(static_cast<int>(std::min(k, 1e9)), 1, cap) : cap;
+  return std::isfinite(k) ? std::max(1, static_cast<int>(std::min(k, 1e9))) : 1000000000;
+}
+
+void Simulation::update_substeps(double dt, bool step_start, StepRecord& record) {
+  // The count rises at once when needed but falls only at the start of a
+  // step, after a lower count has sufficed for a while, to the largest count
+  // needed meanwhile. A count that follows the phase of an oscillation (|v|,
+  // |F| and |tau| all vary along it) makes the integration non-symplectic
+  // and pumps energy into the oscillation (docs/hard-cases.md: a magnet
+  // swinging in a uniform field of 1e5 A/m gained 21 times its swing energy
+  // in 2 s). The hold is one period of the slowest oscillation whose
+  // stiffness alone asks for more than one substep, 2 pi dt / stiffness_limit.
+  const double hold = 2.0 * kPi * dt / std::max(scene_.simulation.stiffness_limit, 1e-9);
+  const int wanted = substeps_needed(dt);
+  record.substeps_wanted = std::max(record.substeps_wanted, wanted);
+  const int needed = std::min(wanted, std::max(1, scene_.simulation.max_substeps));
+  if (needed >= substeps_) {
+    substeps_ = needed;
+    substeps_window_max_ = 1;
+    substeps_set_time_ = time_;
+  } else {
+    substeps_window_max_ = std::max(substeps_window_max_, needed);
+    if (step_start && time_ - substeps_set_time_ >= hold * (1.0 - 1e-9)) {
+      substeps_ = substeps_window_max_;
+      substeps_window_max_ = 1;
+      substeps_set_time_ = time_;
+    }
+  }
 }
 
 void Simulation::step() {
+  if (non_finite_body_ >= 0) throw std::runtime_error(non_finite_message());
   const double dt = scene_.simulation.time_step;
   apply_timeline(dt);
   StepRecord record;
@@ -170,17 +226,28 @@ void Simulation::step() {
     record.residual = std::max(record.residual, report.residual);
   };
   update_forces(time_, dt);
+  update_substeps(dt, true, record);
   // Substeps, each with its own forces: holding one step's forces over
   // several substeps is not symplectic and makes resting contacts unstable
-  // (docs/simulation.md "Substeps").
-  record.substeps = substeps_needed(dt);
-  const double h = dt / record.substeps;
-  for (int k = 0; k < record.substeps; ++k) {
-    if (k > 0) update_forces(time_ + k * h, h);
+  // (docs/simulation.md "Substeps"). The count is checked again after every
+  // substep's forces and raised for the rest of the step when a body sped
+  // up or came closer to a magnet (docs/hard-cases.md: a 0.3 mm ball
+  // falling onto a magnet reached it within one 4 ms step and was thrown out).
+  double done = 0.0;
+  record.substeps = 0;
+  while (true) {
+    const double h = std::min(dt / substeps_, dt - done);
     // T_r: collision, dWorldQuickStep, contacts.
     const auto t0 = std::chrono::steady_clock::now();
     world_->integrate(h);
     record.rigid_ms += elapsed_ms(t0);
+    done += h;
+    ++record.substeps;
+    // A NaN stops the step: ODE's collision would abort on it.
+    note_non_finite(time_ + done);
+    if (dt - done <= 1e-9 * dt || non_finite_body_ >= 0) break;
+    update_forces(time_ + done, dt / substeps_);
+    update_substeps(dt, false, record);
   }
   records_.push_back(record);
   time_ += dt;
@@ -217,6 +284,28 @@ bool Simulation::finite_state(int b) const {
   return is_finite(p.position) && is_finite(world_->velocity(b)) &&
          is_finite(world_->angular_velocity(b)) && is_finite(magnetics_->force(b)) &&
          is_finite(magnetics_->torque(b)) && is_finite(magnetics_->moment(b));
+}
+
+void Simulation::note_non_finite(double t) {
+  if (non_finite_body_ >= 0) return;
+  for (int b = 0; b < world_->body_count(); ++b) {
+    if (finite_state(b)) continue;
+    non_finite_body_ = b;
+    non_finite_step_ = steps_ + 1;
+    non_finite_time_ = t;
+    return;
+  }
+}
+
+std::string Simulation::non_finite_message() const {
+  int body = non_finite_body_;
+  long step = non_finite_step_;
+  double t = non_finite_time_;
+  for (int b = 0; body < 0 && b < world_->body_count(); ++b)
+    if (!finite_state(b)) body = b, step = steps_, t = time_;
+  if (body < 0) return {};
+  return scene_.file + ": body '" + scene_.bodies[body].name + "' has a non-finite state at step " +
+         std::to_string(step) + " (t = " + std::to_string(t) + " s); stopped";
 }
 
 }  // namespace odemag

@@ -19,6 +19,10 @@ struct StepRecord {
   double magnetic_ms = 0.0;  // T_m: relaxation, forces and torques
   double rigid_ms = 0.0;     // T_r: collision, dWorldQuickStep, contacts
   int substeps = 1;          // substeps, each with its own relaxation and collision check
+  // The most substeps the substep rule asked for during the step; above
+  // SimulationSettings::max_substeps its travel and stiffness bounds did not
+  // hold (docs/hard-cases.md: 1 mm objects at 4 ms steps).
+  int substeps_wanted = 1;
   int iterations = 0;        // outer relaxation iterations, summed over the substeps
   bool converged = true;
   double residual = 0.0;
@@ -31,7 +35,9 @@ class Simulation {
 
   // One rigid step of scene.simulation.time_step: time-line events due at the
   // current time, magnetic forces (timed as T_m), collision and integration
-  // (timed as T_r).
+  // (timed as T_r). A substep that leaves a body's state non-finite ends the
+  // step (ODE's collision aborts the process on NaN positions); the next
+  // call throws std::runtime_error with non_finite_message().
   void step();
   // Steps until time() >= t (within half a step).
   void advance_to(double t);
@@ -53,13 +59,26 @@ class Simulation {
   int count_above(const std::string& prefix, double height) const;
   // A body's state is finite (no NaN or infinity in pose, velocity, force).
   bool finite_state(int body) const;
+  // The NaN guard of `odemag run` (docs/hard-cases.md): empty while every
+  // body's state is finite, else "SCENE: body 'NAME' has a non-finite state
+  // at step K (t = T s); stopped" for the body that was found non-finite
+  // first (checked after every substep, so a NaN that spreads to the other
+  // bodies through their fields is traced to where it began), K counting
+  // steps from 1 and T the end of the substep.
+  std::string non_finite_message() const;
 
  private:
   void apply_timeline(double dt);
   // Substeps needed for collision (travel) and for the magnetic force's time
-  // scale (stiffness); see SimulationSettings::max_substeps.
+  // scale (stiffness), before the cap SimulationSettings::max_substeps.
   int substeps_needed(double dt) const;
+  // Sets substeps_ from substeps_needed (capped): raised at once, lowered
+  // only at a step's start after a hold time (simulation.cpp); notes the
+  // uncapped need in record.substeps_wanted.
+  void update_substeps(double dt, bool step_start, StepRecord& record);
   void evaluate_outcomes(bool end);
+  // Records the first body whose state is not finite (non_finite_message).
+  void note_non_finite(double t);
 
   SceneDescription scene_;
   std::unique_ptr<RigidWorld> world_;
@@ -74,7 +93,20 @@ class Simulation {
   std::vector<char> event_state_;
   std::vector<double> ramp_start_scale_;
   std::vector<Vec3> ramp_start_field_;
+  // Substep count in use, and the largest count needed since it was last
+  // set (it falls only after a hold time; see update_substeps).
+  int substeps_ = 1;
+  int substeps_window_max_ = 1;
+  double substeps_set_time_ = 0.0;
   std::vector<double> body_size_;  // smallest half-extent of each body, m
+  // Farthest surface point that a rotation moves (0 for a sphere), m.
+  std::vector<double> body_reach_;
+  std::vector<double> body_inertia_;       // smallest principal moment of inertia, kg m^2
+  std::vector<char> body_turns_in_field_;  // a uniform field exerts a torque on it
+  // The first body found non-finite (-1 while none), its step and time.
+  int non_finite_body_ = -1;
+  long non_finite_step_ = 0;
+  double non_finite_time_ = 0.0;
 };
 
 // Pose on a keyframe track at time t: positions linearly interpolated,

@@ -179,5 +179,55 @@ TEST(Remanence, AnisotropicCellKeepsMagnetizationIsotropicDoesNot) {
   EXPECT_LT(norm(iso.state.magnetization[0]), 0.01 * Ms);
 }
 
+// The O(n) Woodbury step of newton_polish equals the Newton step from the
+// dense Riemannian Hessian (built here entry by entry from the free energy
+// G = -H_A . mean(m) + gamma_D Ms |mean(m)|^2 / 2 + H_K / (2n) sum_k
+// |m_k x e|^2) solved with Eigen, to 1e-9 relative, for 2, 4 and 8 moments near
+// their easy axis (where every diagonal block is positive definite).
+TEST(NewtonPolish, StructuredStepEqualsDenseNewtonStep) {
+  uint64_t key = 7;
+  int checked = 0;
+  for (int n : {2, 4, 8}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      SoftCellParams p = iron(8e5, 1000.0, 3.2e5, n);
+      p.easy_axis = normalized(Vec3{0.3, -0.2, 1.0});
+      Vec3 m[kMaxMomentsPerCell], heff[kMaxMomentsPerCell], basis[2 * kMaxMomentsPerCell];
+      for (int k = 0; k < n; ++k) {
+        const double sign = (k % 3 == 0) ? -1.0 : 1.0;  // some moments against the axis
+        m[k] = normalized(sign * p.easy_axis + 0.3 * random_unit_vector(++key));
+      }
+      const Vec3 H_A = 2e5 * random_unit_vector(++key);
+      const Vec3 mean_m = mean_moment(m, n);
+      const int dim = 2 * n;
+      Eigen::VectorXd grad(dim);
+      for (int k = 0; k < n; ++k) {
+        heff[k] = effective_field(p, H_A, mean_m, m[k]);
+        tangent_basis(m[k], basis[2 * k], basis[2 * k + 1]);
+      }
+      for (int a = 0; a < dim; ++a) grad[a] = -dot(basis[a], heff[a / 2]) / n;
+      Eigen::MatrixXd hess(dim, dim);
+      for (int a = 0; a < dim; ++a)
+        for (int b = 0; b < dim; ++b) {
+          const int k = a / 2, l = b / 2;
+          double h = p.gamma_D * p.Ms / (n * n) * dot(basis[a], basis[b]);
+          if (k == l) {
+            h += p.H_K / n * (dot(basis[a], basis[b]) - dot(basis[a], p.easy_axis) * dot(basis[b], p.easy_axis));
+            if (a == b) h += dot(m[k], heff[k]) / n;
+          }
+          hess(a, b) = h;
+        }
+      const double curvature = (p.gamma_D * p.Ms + p.H_K + norm(H_A)) / n;
+      double step[2 * kMaxMomentsPerCell];
+      if (!structured_newton_step(p, m, heff, basis, grad.data(), curvature, step)) continue;
+      hess.diagonal().array() += 1e-12 * curvature;
+      const Eigen::VectorXd dense = hess.llt().solve(-grad);
+      const Eigen::VectorXd structured = Eigen::Map<Eigen::VectorXd>(step, dim);
+      EXPECT_LT((structured - dense).norm(), 1e-9 * dense.norm()) << "n " << n << " trial " << trial;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 30);  // most configurations take the structured path
+}
+
 }  // namespace
 }  // namespace odemag
