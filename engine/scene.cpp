@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <initializer_list>
 #include <limits>
 #include <set>
@@ -45,6 +46,11 @@ using json = nlohmann::json;
 // beyond it the per-body tensors alone take gigabytes.
 constexpr double kMaxLatticePoints = 4194304.0;  // 2^22
 
+// The deepest scene value is 5 levels down (timeline[0].keys[0].position[0]);
+// deeper nesting is rejected while parsing, so that a file of a million '['
+// fails at once instead of building a million-level tree (docs/testing.md, fuzzing findings).
+constexpr size_t kMaxNesting = 64;
+
 std::string member(const std::string& path, std::string_view key) {
   return path.empty() ? std::string(key) : path + "." + std::string(key);
 }
@@ -60,38 +66,56 @@ std::string as_literal(const std::string& s) {
 
 std::string format_number(double x) { return json(x).dump(); }
 
-// Follows the parser through the document so that errors the parser raises
-// itself (a number too large for a double, a duplicate key) can name the key
-// path where they happened.
-class PathTracker {
+// A first pass over the text (SAX: no tree is built) that checks what the
+// parser itself does not -- nesting depth, duplicate keys -- and, when the
+// parser fails, knows the key path where it failed ("bodies[2].shape"). The
+// tree is then built by a plain json::parse. (nlohmann's parse with a
+// callback, which this pass replaces, takes time quadratic in the length of
+// an array of objects; docs/testing.md, fuzzing findings.)
+class PathTracker : public nlohmann::json_sax<json> {
  public:
   explicit PathTracker(const std::string& file) : file_(file) {}
 
-  bool on_event(json::parse_event_t event, const json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start: frames_.push_back({false, 0, {}, {}}); break;
-      case json::parse_event_t::array_start: frames_.push_back({true, 0, {}, {}}); break;
-      case json::parse_event_t::key: {
-        Frame& top = frames_.back();
-        top.key = parsed.get<std::string>();
-        if (!top.keys.insert(top.key).second)
-          throw SceneError(file_, path(), "key appears twice in the same object");
-        break;
-      }
-      case json::parse_event_t::value: element_done(); break;
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-        frames_.pop_back();
-        element_done();
-        break;
-    }
+  // The parser's error, when it failed (json::sax_parse returned false).
+  const std::optional<std::string>& error() const { return error_; }
+  int error_id() const { return error_id_; }
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override { return start(false); }
+  bool start_array(std::size_t) override { return start(true); }
+  bool end_object() override { return end(); }
+  bool end_array() override { return end(); }
+  bool key(string_t& name) override {
+    Frame& top = frames_.back();
+    top.key = name;
+    if (!top.keys.insert(top.key).second) throw SceneError(file_, path(), "key appears twice in the same object");
     return true;
+  }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override {
+    error_ = e.what();
+    error_id_ = e.id;
+    return false;
   }
 
   // Key path of the value being read.
   std::string path() const {
-    std::string p;
-    for (const Frame& f : frames_) p = f.array ? element(p, f.index) : member(p, f.key);
+    std::string p;  // appended in place: linear in the length of the path
+    for (const Frame& f : frames_) {
+      if (f.array) {
+        p += '[';
+        p += std::to_string(f.index);
+        p += ']';
+      } else {
+        if (!p.empty()) p += '.';
+        p += f.key;
+      }
+    }
     return p;
   }
 
@@ -102,12 +126,25 @@ class PathTracker {
     std::string key;             // object: the member being read
     std::set<std::string> keys;  // object: the keys seen so far
   };
-  void element_done() {
+  bool start(bool array) {
+    if (frames_.size() >= kMaxNesting)
+      throw SceneError(file_, path(), "nested more than " + std::to_string(kMaxNesting) + " levels deep");
+    frames_.push_back({array, 0, {}, {}});
+    return true;
+  }
+  bool end() {
+    frames_.pop_back();
+    return value();
+  }
+  bool value() {
     if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+    return true;
   }
 
   const std::string& file_;
   std::vector<Frame> frames_;
+  std::optional<std::string> error_;
+  int error_id_ = 0;
 };
 
 // nlohmann's what() starts with "[json.exception.NAME.ID] "; drop that.
@@ -244,7 +281,12 @@ class SceneReader {
   }
   Vec3 non_zero_vec3(const json& v, const std::string& path) const {
     const Vec3 a = vec3(v, path);
-    if (norm(a) == 0.0) fail(path, "must not be the zero vector");
+    if (a.x == 0.0 && a.y == 0.0 && a.z == 0.0) fail(path, "must not be the zero vector");
+    // Its length is computed as sqrt(x^2 + y^2 + z^2): [1e-200, 0, 0] would
+    // have length 0 and [1e200, 0, 0] length infinity (docs/testing.md, fuzzing findings).
+    const double n = norm(a);
+    if (!(n > 0.0) || !std::isfinite(n))
+      fail(path, "components too small or too large (the length must be between about 1e-150 and 1e150)");
     return a;
   }
   std::array<double, 3> color(const json& v, const std::string& path) const {
@@ -256,10 +298,16 @@ class SceneReader {
   // [w, x, y, z], normalised.
   Quaternion quaternion(const json& v, const std::string& path) const {
     require_array(v, path, 4);
-    double q[4];
-    for (size_t i = 0; i < 4; ++i) q[i] = number(v[i], element(path, i));
+    double q[4], largest = 0.0;
+    for (size_t i = 0; i < 4; ++i) {
+      q[i] = number(v[i], element(path, i));
+      largest = std::max(largest, std::abs(q[i]));
+    }
+    if (!(largest > 0.0)) fail(path, "must be a non-zero quaternion [w, x, y, z]");
+    // Scaled by the largest component first: [1e300, 0, 0, 0] and
+    // [1e-300, 0, 0, 0] are the identity, not an overflow or a zero.
+    for (double& c : q) c /= largest;
     const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    if (!(n > 0.0) || !std::isfinite(n)) fail(path, "must be a non-zero quaternion [w, x, y, z]");
     return {q[0] / n, q[1] / n, q[2] / n, q[3] / n};
   }
 
@@ -344,6 +392,12 @@ Material read_material(const SceneReader& r, const json& v, const std::string& p
 
 // ---- bodies -----------------------------------------------------------------------
 
+// Body name -> index in scene.bodies, filled as the bodies are read: the
+// duplicate-name check and the events' body lookups stay O(log n) per body
+// (SceneDescription::find_body is a linear search: a file with 16000 bodies
+// and events took seconds; docs/testing.md, fuzzing findings).
+using BodyIndex = std::map<std::string, size_t, std::less<>>;
+
 Shape read_shape(const SceneReader& r, const json& v, const std::string& path) {
   r.check_keys(v, path, {"sphere", "box", "cylinder"});
   if (v.size() != 1)
@@ -372,12 +426,12 @@ Shape read_shape(const SceneReader& r, const json& v, const std::string& path) {
 }
 
 BodyDescription read_body(const SceneReader& r, const json& v, const std::string& path,
-                          const SceneDescription& scene) {
+                          const SceneDescription& scene, const BodyIndex& index) {
   r.check_keys(v, path, {"name", "shape", "material", "position", "orientation", "velocity",
                          "angular_velocity", "fixed", "density", "cell_size", "present", "color"});
   BodyDescription body;
   body.name = r.non_empty_string(r.required(v, "name", path), member(path, "name"));
-  if (scene.find_body(body.name) >= 0)
+  if (index.count(body.name))
     r.fail(member(path, "name"), "another body is already named " + as_literal(body.name));
   body.shape = read_shape(r, r.required(v, "shape", path), member(path, "shape"));
   body.material = r.string(r.required(v, "material", path), member(path, "material"));
@@ -494,8 +548,13 @@ CameraSettings read_camera(const SceneReader& r, const json& v, const std::strin
   r.optional(v, "width", path, [&](const json& x, const std::string& p) { c.width = r.int_value(x, p, 16, 8192); });
   r.optional(v, "height", path, [&](const json& x, const std::string& p) { c.height = r.int_value(x, p, 16, 8192); });
   const Vec3 view = c.target - c.position;
-  if (norm(view) == 0.0) r.fail(member(path, "target"), "must differ from camera.position");
-  if (norm(cross(normalized(view), normalized(c.up))) < 1e-9)
+  if (view.x == 0.0 && view.y == 0.0 && view.z == 0.0)
+    r.fail(member(path, "target"), "must differ from camera.position");
+  // |target - position| can underflow to 0 or overflow to infinity (docs/testing.md, fuzzing findings).
+  const double distance = norm(view);
+  if (!(distance > 0.0) || !std::isfinite(distance))
+    r.fail(member(path, "target"), "distance from camera.position must be between about 1e-150 and 1e150 m");
+  if (!(norm(cross(normalized(view), normalized(c.up))) >= 1e-9))
     r.fail(member(path, "up"), "must not be parallel to the viewing direction (target - position)");
   return c;
 }
@@ -513,13 +572,14 @@ RenderSettings read_render(const SceneReader& r, const json& v, const std::strin
 
 // ---- time line ---------------------------------------------------------------------
 
-// The name of an existing body, read from `key` of the event.
-std::string event_body(const SceneReader& r, const json& v, const std::string& path,
-                       const SceneDescription& scene) {
+// The existing body named by the event's "body".
+const BodyDescription& event_body(const SceneReader& r, const json& v, const std::string& path,
+                                  const SceneDescription& scene, const BodyIndex& index) {
   const std::string p = member(path, "body");
   const std::string name = r.string(r.required(v, "body", path), p);
-  if (scene.find_body(name) < 0) r.fail(p, "no body named " + as_literal(name));
-  return name;
+  const auto it = index.find(name);
+  if (it == index.end()) r.fail(p, "no body named " + as_literal(name));
+  return scene.bodies[it->second];
 }
 
 double event_end_time(const SceneReader& r, const json& v, const std::string& path, double time) {
@@ -554,7 +614,7 @@ std::vector<Keyframe> read_keys(const SceneReader& r, const json& v, const std::
 }
 
 TimelineEvent read_event(const SceneReader& r, const json& v, const std::string& path,
-                         const SceneDescription& scene) {
+                         const SceneDescription& scene, const BodyIndex& index) {
   using Kind = TimelineEvent::Kind;
   r.require_object(v, path);
   const std::string action =
@@ -569,13 +629,13 @@ TimelineEvent read_event(const SceneReader& r, const json& v, const std::string&
     r.check_keys(v, path, {"time", "action", "body"});
     e.kind = action == "add" ? Kind::add_body : Kind::remove_body;
     read_time();
-    e.body = event_body(r, v, path, scene);
+    e.body = event_body(r, v, path, scene, index).name;
   } else if (action == "scale_magnetization") {
     r.check_keys(v, path, {"time", "action", "body", "to", "end_time"});
     e.kind = Kind::scale_magnetization;
     read_time();
-    e.body = event_body(r, v, path, scene);
-    const BodyDescription& body = scene.bodies[static_cast<size_t>(scene.find_body(e.body))];
+    const BodyDescription& body = event_body(r, v, path, scene, index);
+    e.body = body.name;
     const Material& material = scene.materials.at(body.material);
     const SoftMaterial* soft = std::get_if<SoftMaterial>(&material);
     const bool electromagnet = soft && norm(soft->coil_field) > 0.0;
@@ -599,8 +659,8 @@ TimelineEvent read_event(const SceneReader& r, const json& v, const std::string&
   } else {
     r.check_keys(v, path, {"time", "action", "body", "keys"});
     e.kind = Kind::keyframes;
-    e.body = event_body(r, v, path, scene);
-    const BodyDescription& body = scene.bodies[static_cast<size_t>(scene.find_body(e.body))];
+    const BodyDescription& body = event_body(r, v, path, scene, index);
+    e.body = body.name;
     e.keys = read_keys(r, r.required(v, "keys", path), member(path, "keys"), body);
     e.time = e.keys.front().time;
     r.optional(v, "time", path, [&](const json& x, const std::string& p) { e.time = r.non_negative(x, p); });
@@ -652,15 +712,18 @@ SceneDescription read_scene(const SceneReader& r, const json& root) {
 
   const json& bodies = r.required(root, "bodies", "");
   if (!bodies.is_array() || bodies.empty()) r.fail("bodies", "must be a non-empty array of bodies");
-  for (size_t b = 0; b < bodies.size(); ++b)
-    scene.bodies.push_back(read_body(r, bodies[b], element("bodies", b), scene));
+  BodyIndex index;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    scene.bodies.push_back(read_body(r, bodies[b], element("bodies", b), scene, index));
+    index.emplace(scene.bodies.back().name, b);
+  }
 
   r.optional(root, "solver", "", [&](const json& x, const std::string& p) { scene.solver = read_solver(r, x, p); });
   r.optional(root, "simulation", "",
              [&](const json& x, const std::string& p) { scene.simulation = read_simulation(r, x, p); });
   r.optional(root, "timeline", "", [&](const json& x, const std::string& p) {
     if (!x.is_array()) r.fail(p, "must be an array of events");
-    for (size_t i = 0; i < x.size(); ++i) scene.timeline.push_back(read_event(r, x[i], element(p, i), scene));
+    for (size_t i = 0; i < x.size(); ++i) scene.timeline.push_back(read_event(r, x[i], element(p, i), scene, index));
   });
   r.optional(root, "camera", "", [&](const json& x, const std::string& p) { scene.camera = read_camera(r, x, p); });
   r.optional(root, "render", "", [&](const json& x, const std::string& p) { scene.render = read_render(r, x, p); });
@@ -681,21 +744,18 @@ SceneDescription read_scene(const SceneReader& r, const json& root) {
 
 SceneDescription parse_scene(const std::string& json_text, const std::string& file) {
   PathTracker tracker(file);
+  if (!json::sax_parse(json_text, &tracker)) {
+    const std::string what = without_exception_tag(tracker.error().value_or("syntax error"));
+    // 406: a number too large for a double (1e999); JSON has no infinity.
+    if (tracker.error_id() == 406) throw SceneError(file, tracker.path(), what + " (numbers must be finite)");
+    const std::string where = tracker.path();
+    throw SceneError(file, "", "invalid JSON: " + what + (where.empty() ? "" : " (while reading " + where + ")"));
+  }
   json root;
   try {
-    root = json::parse(json_text, [&](int, json::parse_event_t event, json& parsed) {
-      return tracker.on_event(event, parsed);
-    });
-  } catch (const json::parse_error& e) {
-    const std::string where = tracker.path();
-    throw SceneError(file, "", "invalid JSON: " + without_exception_tag(e.what()) +
-                                   (where.empty() ? "" : " (while reading " + where + ")"));
-  } catch (const json::out_of_range& e) {
-    // 406: a number too large for a double (1e999); JSON has no infinity.
-    throw SceneError(file, tracker.path(),
-                     without_exception_tag(e.what()) + " (numbers must be finite)");
+    root = json::parse(json_text);  // the text the first pass accepted
   } catch (const json::exception& e) {
-    throw SceneError(file, tracker.path(), "invalid JSON: " + without_exception_tag(e.what()));
+    throw SceneError(file, "", "invalid JSON: " + without_exception_tag(e.what()));
   }
   if (!root.is_object()) throw SceneError(file, "", "the scene must be a JSON object {...}");
   return read_scene(SceneReader(file), root);
@@ -706,10 +766,17 @@ SceneDescription load_scene(const std::string& path) {
   if (std::filesystem::is_directory(path, ec)) throw SceneError(path, "", "cannot open: is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, "", std::string("cannot open: ") + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read in pieces up to a bound: `odemag solve /dev/zero` must not take all
+  // the memory (a scene of a million bodies is about 60 MB).
+  constexpr size_t kMaxSceneBytes = size_t{256} << 20;
+  std::string text;
+  char buffer[65536];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+    text.append(buffer, static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxSceneBytes) throw SceneError(path, "", "the file is larger than 256 MiB");
+  }
   if (in.bad()) throw SceneError(path, "", "cannot read the file");
-  return parse_scene(text.str(), path);
+  return parse_scene(text, path);
 }
 
 }  // namespace odemag

@@ -1,13 +1,22 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages odemag needs, only those that are missing.
-# Runs as root (or with sudo). Usage: scripts/install-deps.sh [extra packages...]
+# Runs as root (or with sudo). Usage: scripts/install-deps.sh [--sanitize] [extra packages...]
+# --sanitize adds what scripts/sanitize.sh needs: clang-14 with libFuzzer and
+# the sanitizer runtimes, and clang's OpenMP (libomp) for the fuzz build.
 set -euo pipefail
+
+sanitize_packages=()
+if [[ "${1:-}" == --sanitize ]]; then
+  sanitize_packages=(clang-14 libclang-rt-14-dev libomp-14-dev)
+  shift
+fi
 
 packages=(
   build-essential cmake pkg-config
   libode-dev libeigen3-dev libosmesa6-dev libpng-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
   gnuplot-nox
+  "${sanitize_packages[@]}"
   "$@"
 )
 

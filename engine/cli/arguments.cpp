@@ -1,6 +1,7 @@
 // Command-line arguments of the odemag subcommands.
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 
 #include "engine/cli/cli.h"
@@ -64,6 +65,78 @@ SolveOptions solve_options(const Arguments& args) {
     o.threads = static_cast<int>(n);
   }
   return o;
+}
+
+namespace {
+
+// --NAME as a finite number >= 0 (> 0 unless allow_zero); nullopt when absent.
+std::optional<double> number_option(const Arguments& a, const std::string& name, bool allow_zero) {
+  const auto v = a.option(name);
+  if (!v) return std::nullopt;
+  char* end = nullptr;
+  const double x = std::strtod(v->c_str(), &end);
+  if (end == v->c_str() || *end != '\0' || !std::isfinite(x) || x < 0.0 || (!allow_zero && x == 0.0))
+    throw UsageError("--" + name + ": expected a " + (allow_zero ? "non-negative" : "positive") +
+                     " number, got '" + *v + "'");
+  return x;
+}
+
+std::optional<int> int_option(const Arguments& a, const std::string& name, int lo, int hi) {
+  const std::optional<double> x = number_option(a, name, true);
+  if (!x) return std::nullopt;
+  if (*x != std::floor(*x) || *x < lo || *x > hi)
+    throw UsageError("--" + name + ": expected an integer from " + std::to_string(lo) + " to " +
+                     std::to_string(hi));
+  return static_cast<int>(*x);
+}
+
+bool yes_no_option(const Arguments& a, const std::string& name, bool fallback) {
+  const auto v = a.option(name);
+  if (!v) return fallback;
+  if (*v == "yes" || *v == "true" || *v == "1") return true;
+  if (*v == "no" || *v == "false" || *v == "0") return false;
+  throw UsageError("--" + name + ": expected yes or no, got '" + *v + "'");
+}
+
+}  // namespace
+
+SolveCommandLine parse_solve_command(const std::vector<std::string>& args) {
+  const Arguments a = parse_arguments("solve", args, {"backend", "threads"});
+  SolveCommandLine c;
+  c.solve = solve_options(a);
+  c.scene = scene_argument("solve", a);
+  return c;
+}
+
+FieldCommandLine parse_field_command(const std::vector<std::string>& args) {
+  const Arguments a = parse_arguments("field", args, {"points", "backend", "threads"});
+  FieldCommandLine c;
+  c.solve = solve_options(a);
+  c.scene = scene_argument("field", a);
+  const std::optional<std::string> points = a.option("points");
+  if (!points) throw UsageError("'field' needs --points FILE (see odemag --help)");
+  c.points = *points;
+  return c;
+}
+
+RunCommandLine parse_run_command(const std::vector<std::string>& args) {
+  const Arguments a = parse_arguments(
+      "run", args,
+      {"out", "duration", "frame-rate", "time-step", "frames", "width", "height", "backend", "threads", "quiet"});
+  RunCommandLine c;
+  c.scene = scene_argument("run", a);
+  const auto out = a.option("out");
+  if (!out || out->empty()) throw UsageError("'run' needs --out DIR (see odemag --help)");
+  c.out = *out;
+  c.solve = solve_options(a);
+  c.duration = number_option(a, "duration", true);
+  c.frame_rate = number_option(a, "frame-rate", false);
+  c.time_step = number_option(a, "time-step", false);
+  c.width = int_option(a, "width", 16, 8192);
+  c.height = int_option(a, "height", 16, 8192);
+  c.frames = yes_no_option(a, "frames", true);
+  c.quiet = yes_no_option(a, "quiet", false);
+  return c;
 }
 
 const char* usage_text() {

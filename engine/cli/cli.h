@@ -52,6 +52,28 @@ struct SolveOptions {
 };
 SolveOptions solve_options(const Arguments& args);
 
+// The whole command line of each command (args after the command word),
+// checked without reading or writing any file: the run_* functions start
+// with these, and tests/fuzz/fuzz_cli.cpp fuzzes them. Throw UsageError.
+struct SolveCommandLine {
+  std::string scene;
+  SolveOptions solve;
+};
+struct FieldCommandLine {
+  std::string scene, points;
+  SolveOptions solve;
+};
+struct RunCommandLine {
+  std::string scene, out;
+  SolveOptions solve;
+  std::optional<double> duration, frame_rate, time_step;  // override the scene's simulation.*
+  std::optional<int> width, height;                       // override the scene's camera.*
+  bool frames = true, quiet = false;
+};
+SolveCommandLine parse_solve_command(const std::vector<std::string>& args);
+FieldCommandLine parse_field_command(const std::vector<std::string>& args);
+RunCommandLine parse_run_command(const std::vector<std::string>& args);
+
 // Points for `odemag field`: one "x,y,z" per line; blank lines, '#' comments
 // and a first line "x,y,z" are skipped. Throws SceneError(file, "line N", ...).
 std::vector<Vec3> parse_points(const std::string& text, const std::string& file);

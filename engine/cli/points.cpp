@@ -59,6 +59,20 @@ std::string excerpt(const std::string& line) {
   return line.size() > 60 ? s + "..." : s;
 }
 
+// The whole stream, up to a bound: `--points /dev/zero` must not take all the
+// memory. Throws SceneError(file, "", ...).
+std::string read_bounded(std::istream& in, const std::string& file) {
+  constexpr size_t kMaxPointsBytes = size_t{256} << 20;
+  std::string text;
+  char buffer[65536];
+  while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+    text.append(buffer, static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxPointsBytes) throw SceneError(file, "", "the points file is larger than 256 MiB");
+  }
+  if (in.bad()) throw SceneError(file, "", "cannot read the file");
+  return text;
+}
+
 }  // namespace
 
 std::vector<Vec3> parse_points(const std::string& text, const std::string& file) {
@@ -87,20 +101,12 @@ std::vector<Vec3> parse_points(const std::string& text, const std::string& file)
 }
 
 std::vector<Vec3> read_points(const std::string& path) {
-  if (path == "-") {
-    std::ostringstream text;
-    text << std::cin.rdbuf();
-    if (std::cin.bad()) throw SceneError("<stdin>", "", "cannot read the points from standard input");
-    return parse_points(text.str(), "<stdin>");
-  }
+  if (path == "-") return parse_points(read_bounded(std::cin, "<stdin>"), "<stdin>");
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw SceneError(path, "", "cannot open: is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, "", std::string("cannot open: ") + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw SceneError(path, "", "cannot read the file");
-  return parse_points(text.str(), path);
+  return parse_points(read_bounded(in, path), path);
 }
 
 }  // namespace odemag::cli

@@ -22,33 +22,6 @@ using json = nlohmann::ordered_json;
 
 json vec(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
 
-double number_option(const Arguments& a, const std::string& name, double fallback, bool allow_zero) {
-  const auto v = a.option(name);
-  if (!v) return fallback;
-  char* end = nullptr;
-  const double x = std::strtod(v->c_str(), &end);
-  if (end == v->c_str() || *end != '\0' || !std::isfinite(x) || x < 0.0 || (!allow_zero && x == 0.0))
-    throw UsageError("--" + name + ": expected a " + (allow_zero ? "non-negative" : "positive") +
-                     " number, got '" + *v + "'");
-  return x;
-}
-
-int int_option(const Arguments& a, const std::string& name, int fallback, int lo, int hi) {
-  const double x = number_option(a, name, fallback, true);
-  if (x != std::floor(x) || x < lo || x > hi)
-    throw UsageError("--" + name + ": expected an integer from " + std::to_string(lo) + " to " +
-                     std::to_string(hi));
-  return static_cast<int>(x);
-}
-
-bool yes_no_option(const Arguments& a, const std::string& name, bool fallback) {
-  const auto v = a.option(name);
-  if (!v) return fallback;
-  if (*v == "yes" || *v == "true" || *v == "1") return true;
-  if (*v == "no" || *v == "false" || *v == "0") return false;
-  throw UsageError("--" + name + ": expected yes or no, got '" + *v + "'");
-}
-
 // Median, 90th percentile (nearest rank), mean, max and total of a sample.
 json statistics(std::vector<double> x) {
   if (x.empty()) return json::object();
@@ -81,11 +54,7 @@ json frame_state(const Simulation& sim, int frame) {
 // Stops the run when a body's state is NaN or infinite; nothing of that step
 // is written.
 void check_finite(const Simulation& sim) {
-  for (int b = 0; b < sim.world().body_count(); ++b)
-    if (!sim.finite_state(b))
-      throw std::runtime_error(sim.scene().file + ": body '" + sim.scene().bodies[b].name +
-                               "' has a non-finite state at step " + std::to_string(sim.steps()) +
-                               " (t = " + std::to_string(sim.time()) + " s); stopped");
+  if (std::string message = sim.non_finite_message(); !message.empty()) throw std::runtime_error(message);
 }
 
 class Progress {
@@ -122,32 +91,28 @@ std::string frame_name(int frame) {
 }  // namespace
 
 int run_simulation(const std::vector<std::string>& args, const FrameWriterFactory& frames) {
-  const Arguments a = parse_arguments(
-      "run", args,
-      {"out", "duration", "frame-rate", "time-step", "frames", "width", "height", "backend", "threads", "quiet"});
-  const std::string scene_file = scene_argument("run", a);
-  const auto out = a.option("out");
-  if (!out || out->empty()) throw UsageError("'run' needs --out DIR (see odemag --help)");
-  const SolveOptions options = solve_options(a);
+  const RunCommandLine c = parse_run_command(args);
+  const std::string& out = c.out;
+  const SolveOptions& options = c.solve;
 
-  SceneDescription scene = load_scene(scene_file);
+  SceneDescription scene = load_scene(c.scene);
   SimulationSettings& settings = scene.simulation;
-  settings.duration = number_option(a, "duration", settings.duration, true);
-  settings.frame_rate = number_option(a, "frame-rate", settings.frame_rate, false);
-  settings.time_step = number_option(a, "time-step", settings.time_step, false);
-  scene.camera.width = int_option(a, "width", scene.camera.width, 16, 8192);
-  scene.camera.height = int_option(a, "height", scene.camera.height, 16, 8192);
-  const bool want_frames = yes_no_option(a, "frames", true);
-  const bool quiet = yes_no_option(a, "quiet", false);
+  settings.duration = c.duration.value_or(settings.duration);
+  settings.frame_rate = c.frame_rate.value_or(settings.frame_rate);
+  settings.time_step = c.time_step.value_or(settings.time_step);
+  scene.camera.width = c.width.value_or(scene.camera.width);
+  scene.camera.height = c.height.value_or(scene.camera.height);
+  const bool want_frames = c.frames;
+  const bool quiet = c.quiet;
 
   std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
   const std::string backend_name = backend->name();
   Simulation sim(scene, std::move(backend));
 
   std::error_code ec;
-  std::filesystem::create_directories(*out, ec);
-  if (ec) throw std::runtime_error("cannot create output directory " + *out + ": " + ec.message());
-  const std::filesystem::path dir(*out);
+  std::filesystem::create_directories(out, ec);
+  if (ec) throw std::runtime_error("cannot create output directory " + out + ": " + ec.message());
+  const std::filesystem::path dir(out);
   std::unique_ptr<FrameWriter> frame_writer;
   if (want_frames && frames) frame_writer = frames(scene);
   if (want_frames && !frame_writer)

@@ -84,9 +84,9 @@ void write_stdout(const std::string& text) {
 }
 
 int run_solve(const std::vector<std::string>& args) {
-  const Arguments a = parse_arguments("solve", args, {"backend", "threads"});
-  const SolveOptions options = solve_options(a);
-  const SceneDescription scene = load_scene(scene_argument("solve", a));
+  const SolveCommandLine c = parse_solve_command(args);
+  const SolveOptions& options = c.solve;
+  const SceneDescription scene = load_scene(c.scene);
   MagneticScene ms = build_magnetic_scene(scene);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
   const RelaxReport report = magnetic_step(ms.model, ms.state, scene.solver.relax, *backend);
@@ -121,14 +121,11 @@ int run_solve(const std::vector<std::string>& args) {
 }
 
 int run_field(const std::vector<std::string>& args) {
-  const Arguments a = parse_arguments("field", args, {"points", "backend", "threads"});
-  const SolveOptions options = solve_options(a);
-  const std::string scene_file = scene_argument("field", a);
-  const std::optional<std::string> points_file = a.option("points");
-  if (!points_file) throw UsageError("'field' needs --points FILE (see odemag --help)");
+  const FieldCommandLine c = parse_field_command(args);
+  const SolveOptions& options = c.solve;
 
-  const SceneDescription scene = load_scene(scene_file);
-  const std::vector<Vec3> points = read_points(*points_file);
+  const SceneDescription scene = load_scene(c.scene);
+  const std::vector<Vec3> points = read_points(c.points);
   MagneticScene ms = build_magnetic_scene(scene);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
   const RelaxReport report = relax(ms.model, ms.state, scene.solver.relax, *backend);

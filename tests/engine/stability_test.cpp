@@ -141,7 +141,6 @@ TEST(StabilityCraneHeap, ThousandBallsSettleForAFewStepsWithinBounds) {
   EXPECT_LT(r.max_speed, std::sqrt(2.0 * 9.81 * top));
   EXPECT_LE(r.max_energy_rise,
             1.5 * available_energy(r, false) + 1e-12 * std::abs(r.initial_energy));
-  EXPECT_LT(r.wall_seconds, 60.0);
 }
 
 // ---- external fields ------------------------------------------------------------
