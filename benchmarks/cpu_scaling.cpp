@@ -55,6 +55,7 @@
 #include <thread>
 #include <vector>
 
+#include "benchmarks/bench_common.h"
 #include "benchmarks/timed_backend.h"
 #include "magnetics/backend.h"
 #include "magnetics/relax.h"
@@ -223,23 +224,11 @@ struct Row {
   double core_ns_per_pair = 0, gflops_per_core = 0;
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) out.push_back(item);
-  return out;
-}
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (!std::getenv("OMP_WAIT_POLICY")) {
-    // Sleeping instead of spinning OpenMP threads: on a machine shared with
-    // other jobs, spinning barriers slow small two-thread runs many times.
-    setenv("OMP_WAIT_POLICY", "passive", 1);
-    execv("/proc/self/exe", argv);
-  }
+  bench::restart_with_passive_omp(argv);
   std::string out_dir = "benchmarks/results", layouts = "lattice,balls", thread_list = "1,2";
   int max_cells = 16384, fma_units = 0;
   double budget = 6.0, ghz = 0.0;
@@ -268,12 +257,12 @@ int main(int argc, char** argv) {
   }
   const Machine machine = read_machine(ghz, fma_units);
   std::vector<int> threads;
-  for (const std::string& t : split(thread_list)) threads.push_back(std::atoi(t.c_str()));
+  for (const std::string& t : bench::split(thread_list)) threads.push_back(std::atoi(t.c_str()));
   std::fprintf(stderr, "cpu_scaling: %s, %d CPUs, %.2f GHz, %d FMA units: peak %.1f GFLOP/s per core\n",
                machine.model.c_str(), machine.cpus, machine.ghz, machine.fma_units, machine.peak(1));
 
   std::vector<Row> rows;
-  for (const std::string& layout : split(layouts)) {
+  for (const std::string& layout : bench::split(layouts)) {
     if (layout != "lattice" && layout != "balls") {
       std::fprintf(stderr, "cpu_scaling: unknown layout '%s'\n", layout.c_str());
       return 2;

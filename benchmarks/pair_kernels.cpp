@@ -9,6 +9,7 @@
 
 #include <cmath>
 
+#include "benchmarks/bench_common.h"
 #include "magnetics/backend.h"
 #include "magnetics/rng.h"
 
@@ -17,25 +18,7 @@ namespace {
 
 constexpr double kFieldFlops = 33.0, kForceFlops = 57.0;
 
-// N soft one-cell balls scattered in a cube, magnetized randomly.
-struct Heap {
-  MagneticModel model;
-  MagneticState state;
-  explicit Heap(int n) {
-    SoftMaterial steel;
-    steel.saturation = 1.6e6;
-    steel.susceptibility = 1000;
-    const double side = 0.011 * std::cbrt(static_cast<double>(n));
-    for (int i = 0; i < n; ++i) model.add_body(std::to_string(i), Sphere{0.005}, steel, 0.0);
-    state = make_state(model, 5);
-    for (int i = 0; i < n; ++i) {
-      state.pose[i].position = side * Vec3{unit_interval(hash_key(1, i, 0, 0)), unit_interval(hash_key(1, i, 1, 0)),
-                                           unit_interval(hash_key(1, i, 2, 0))};
-      state.magnetization[i] = 5e5 * random_unit_vector(hash_key(2, i, 0, 0));
-    }
-    for (int i = 0; i < n; ++i) state.cell_position[i] = state.pose[i].position;
-  }
-};
+using Heap = bench::BallHeap;
 
 void ResponsiveField(benchmark::State& bench) {
   const int n = static_cast<int>(bench.range(0)), threads = static_cast<int>(bench.range(1));

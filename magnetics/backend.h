@@ -31,6 +31,11 @@ class MagneticBackend {
   // changed (call after place_cells).
   virtual void begin_step(const MagneticModel& model, const MagneticState& state) = 0;
 
+  // Far-field approximation of the inter-body responsive field (docs/model.md
+  // "Far field"), taking effect at the next begin_step: theta = 0 sums every
+  // pair exactly. A backend without the approximation always sums exactly.
+  virtual void set_far_field(double theta) { (void)theta; }
+
   // H_E plus the field of every fixed permanent cell, at each active
   // responsive cell. Constant during a relaxation.
   virtual void fixed_field(const MagneticModel& model, const MagneticState& state,

@@ -5,8 +5,10 @@
 #include <algorithm>
 
 #include "magnetics/backend.h"
+#include "magnetics/far_field.h"
 #include "magnetics/field_probe.h"
 #include "magnetics/kernels.h"
+#include "magnetics/pair_sums.h"
 #include "magnetics/simd.h"
 
 namespace odemag {
@@ -16,6 +18,12 @@ namespace {
 // Below this many pair interactions a loop runs on one thread: waking the
 // team costs more than it saves.
 constexpr long kParallelPairs = 20000;
+
+// Fewer responsive cells than this are summed exactly even when the far-field
+// approximation is on: in the plate scenes (140-190 cells, one lattice body
+// whose nodes are always opened) the tree was 1.2x slower than the exact sum
+// (docs/benchmarks.md section 2b).
+constexpr int kMinTreeCells = 512;
 
 // Cells as structure of arrays, for the pair loops.
 struct CellArrays {
@@ -35,6 +43,9 @@ struct CellArrays {
     cell.push_back(c);
     body.push_back(model.cell_body(c));
   }
+  SourceArrays sources() const {
+    return {x.data(), y.data(), z.data(), radius.data(), mx.data(), my.data(), mz.data()};
+  }
   void load_moments(const MagneticModel& model, const MagneticState& state) {
     for (int i = 0; i < size(); ++i) {
       const Vec3 mu = model.body(body[i]).cells.cell_volume * state.magnetization[cell[i]];
@@ -42,50 +53,6 @@ struct CellArrays {
     }
   }
 };
-
-// Field at (tx, ty, tz) of sources [j0, j1) through the kernel with contact
-// distance target_radius + source radius.
-inline Vec3 sum_field(const CellArrays& s, int j0, int j1, double tx, double ty, double tz,
-                      double target_radius) {
-  const double* __restrict x = s.x.data();
-  const double* __restrict y = s.y.data();
-  const double* __restrict z = s.z.data();
-  const double* __restrict r = s.radius.data();
-  const double* __restrict mx = s.mx.data();
-  const double* __restrict my = s.my.data();
-  const double* __restrict mz = s.mz.data();
-#if ODEMAG_HAVE_SIMD8
-  Simd8 hx, hy, hz;
-  for (int j = j0; j < j1; j += 8) {
-    const int count = j1 - j < 8 ? j1 - j : 8;
-    const Simd8 dx = Simd8(tx) - Simd8::load(x + j, count), dy = Simd8(ty) - Simd8::load(y + j, count),
-                dz = Simd8(tz) - Simd8::load(z + j, count);
-    const Simd8 contact = Simd8(target_radius) + Simd8::load(r + j, count);
-    const Simd8 r2 = dx * dx + dy * dy + dz * dz;
-    const DipoleCoefficientsT<Simd8> c = dipole_coefficients_from(r2, inverse_sqrt(max(r2, contact * contact)));
-    const Simd8 ax = Simd8::load(mx + j, count), ay = Simd8::load(my + j, count), az = Simd8::load(mz + j, count);
-    const Simd8 rm = c.B * (dx * ax + dy * ay + dz * az);
-    // Lanes past the end hold zero moments, so they add nothing.
-    hx += c.A * ax + rm * dx;
-    hy += c.A * ay + rm * dy;
-    hz += c.A * az + rm * dz;
-  }
-  return {hx.sum(), hy.sum(), hz.sum()};
-#else
-  double hx = 0, hy = 0, hz = 0;
-#pragma omp simd reduction(+ : hx, hy, hz)
-  for (int j = j0; j < j1; ++j) {
-    const double dx = tx - x[j], dy = ty - y[j], dz = tz - z[j];
-    const double contact = target_radius + r[j];
-    const DipoleCoefficients c = dipole_coefficients(dx * dx + dy * dy + dz * dz, contact * contact);
-    const double rm = c.B * (dx * mx[j] + dy * my[j] + dz * mz[j]);
-    hx += c.A * mx[j] + rm * dx;
-    hy += c.A * my[j] + rm * dy;
-    hz += c.A * mz[j] + rm * dz;
-  }
-  return {hx, hy, hz};
-#endif
-}
 
 // Force (N) on, and field (A/m) at, a target cell (position t, moment mt,
 // contact radius rt) from sources [j0, j1), through the kernel with contact
@@ -104,23 +71,23 @@ inline ForceAndField sum_force_and_field(const CellArrays& s, int j0, int j1, co
   const double* __restrict mz = s.mz.data();
   // F = mu0 [B ((r.mu_a) mu_b + (r.mu_b) mu_a + (mu_a.mu_b) r) + C (r.mu_a)(r.mu_b) r]
   // (magnetics/kernels.h), mu_a the source, mu_b the target.
-#if ODEMAG_HAVE_SIMD8
-  Simd8 fx, fy, fz, hx, hy, hz;
-  const Simd8 bx(mt.x), by(mt.y), bz(mt.z);
-  for (int j = j0; j < j1; j += 8) {
-    const int count = j1 - j < 8 ? j1 - j : 8;
-    const Simd8 dx = Simd8(t.x) - Simd8::load(x + j, count), dy = Simd8(t.y) - Simd8::load(y + j, count),
-                dz = Simd8(t.z) - Simd8::load(z + j, count);
-    const Simd8 contact = Simd8(rt) + Simd8::load(r + j, count);
-    const Simd8 r2 = dx * dx + dy * dy + dz * dz;
-    const DipoleCoefficientsT<Simd8> c = dipole_coefficients_from(r2, inverse_sqrt(max(r2, contact * contact)));
-    const Simd8 ax = Simd8::load(mx + j, count), ay = Simd8::load(my + j, count), az = Simd8::load(mz + j, count);
-    const Simd8 ra = dx * ax + dy * ay + dz * az, rb = dx * bx + dy * by + dz * bz;
-    const Simd8 radial = c.B * (ax * bx + ay * by + az * bz) + c.C * ra * rb;
+#if ODEMAG_HAVE_SIMD
+  SimdD fx, fy, fz, hx, hy, hz;
+  const SimdD bx(mt.x), by(mt.y), bz(mt.z);
+  for (int j = j0; j < j1; j += kSimdWidth) {
+    const int count = j1 - j < kSimdWidth ? j1 - j : kSimdWidth;
+    const SimdD dx = SimdD(t.x) - SimdD::load(x + j, count), dy = SimdD(t.y) - SimdD::load(y + j, count),
+                dz = SimdD(t.z) - SimdD::load(z + j, count);
+    const SimdD contact = SimdD(rt) + SimdD::load(r + j, count);
+    const SimdD r2 = dx * dx + dy * dy + dz * dz;
+    const DipoleCoefficientsT<SimdD> c = dipole_coefficients_from(r2, inverse_sqrt(max(r2, contact * contact)));
+    const SimdD ax = SimdD::load(mx + j, count), ay = SimdD::load(my + j, count), az = SimdD::load(mz + j, count);
+    const SimdD ra = dx * ax + dy * ay + dz * az, rb = dx * bx + dy * by + dz * bz;
+    const SimdD radial = c.B * (ax * bx + ay * by + az * bz) + c.C * ra * rb;
     fx += c.B * (ra * bx + rb * ax) + radial * dx;
     fy += c.B * (ra * by + rb * ay) + radial * dy;
     fz += c.B * (ra * bz + rb * az) + radial * dz;
-    const Simd8 rm = c.B * ra;
+    const SimdD rm = c.B * ra;
     hx += c.A * ax + rm * dx;
     hy += c.A * ay + rm * dy;
     hz += c.A * az + rm * dz;
@@ -176,14 +143,20 @@ class CpuBackend final : public MagneticBackend {
       for (int i = all_begin; i < all_.size(); ++i) all_range_.push_back({all_begin, all_.size()});
     }
     fixed_.load_moments(model, state);
+    use_tree_ = far_field_theta_ > 0.0 && resp_.size() >= kMinTreeCells;
+    if (use_tree_)
+      tree_.build(resp_.x.data(), resp_.y.data(), resp_.z.data(), resp_.radius.data(), resp_.body.data(),
+                  resp_.size(), far_field_theta_);
   }
+
+  void set_far_field(double theta) override { far_field_theta_ = theta; }
 
   void fixed_field(const MagneticModel&, const MagneticState& state, std::vector<Vec3>& H) override {
     const int n = resp_.size();
 #pragma omp parallel for schedule(static) num_threads(threads_) if (static_cast<long>(n) * fixed_.size() > kParallelPairs)
     for (int i = 0; i < n; ++i)
       H[resp_.cell[i]] = state.external_field +
-                         sum_field(fixed_, 0, fixed_.size(), resp_.x[i], resp_.y[i], resp_.z[i],
+                         sum_field(fixed_.sources(), 0, fixed_.size(), resp_.x[i], resp_.y[i], resp_.z[i],
                                    resp_.radius[i]);
   }
 
@@ -196,12 +169,18 @@ class CpuBackend final : public MagneticBackend {
     for (int i = 0; i < n; ++i)
       body_moment_[i] = state.pose[resp_.body[i]].rotation.transpose_times(
           {resp_.mx[i], resp_.my[i], resp_.mz[i]});
+    // Inter-body part from the far-field tree, when it is on.
+    if (use_tree_) {
+      tree_field_.resize(n);
+      tree_.field(resp_.mx.data(), resp_.my.data(), resp_.mz.data(), tree_field_.data(), threads_);
+    }
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads_) if (static_cast<long>(n) * n > kParallelPairs)
     for (int i = 0; i < n; ++i) {
       const auto [begin, end] = resp_range_[i];
       // Inter-body: every responsive cell of another body.
-      Vec3 h = sum_field(resp_, 0, begin, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]) +
-               sum_field(resp_, end, n, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]);
+      Vec3 h = use_tree_ ? tree_field_[i]
+                         : sum_field(resp_.sources(), 0, begin, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]) +
+                               sum_field(resp_.sources(), end, n, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]);
       // Intra-body: cached tensors of the body, in the body frame.
       const MagneticBody& body = model.body(resp_.body[i]);
       if (end - begin > 1) {
@@ -293,6 +272,10 @@ class CpuBackend final : public MagneticBackend {
   std::vector<std::pair<int, int>> resp_range_;  // per responsive cell: its body's range in resp_
   std::vector<std::pair<int, int>> all_range_;   // per cell: its body's range in all_
   std::vector<Vec3> body_moment_, cell_force_, cell_field_;
+  double far_field_theta_ = 0.0;  // 0: every pair summed exactly
+  bool use_tree_ = false;
+  FarFieldTree tree_;
+  std::vector<Vec3> tree_field_;
 };
 
 }  // namespace

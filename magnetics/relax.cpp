@@ -79,6 +79,7 @@ void add_coil_fields(const MagneticModel& model, const MagneticState& state, con
 RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
                   MagneticBackend& backend) {
   place_cells(model, state);
+  backend.set_far_field(o.far_field_theta);
   backend.begin_step(model, state);
   const std::vector<int> cells = active_responsive_cells(model, state);
   if (cells.empty()) {

@@ -36,6 +36,10 @@ struct RelaxOptions {
   // false: induced (responsive) cells feel only H_E and the fixed permanent
   // magnets, not each other (the paper's Fig. 12c comparison).
   bool mutual_induction = true;
+  // Opening parameter of the far-field approximation of the responsive field
+  // (docs/model.md "Far field"; CPU backend, 512 responsive cells or more):
+  // 0 sums every pair exactly; the error falls as theta^2.
+  double far_field_theta = 0.0;
   LocalRelaxOptions local;
 };
 

@@ -130,7 +130,7 @@ TEST(SceneParser, AllSettings) {
     "title": "all", "seed": 42, "external_field": [1, 2, 3],
     "solver": {"scheme": "paper", "tolerance": 1e-5, "max_iterations": 50, "anderson_depth": 0,
                "mixing": 0.5, "mutual_induction": false, "time_step_factor": 0.3, "noise": 0,
-               "backend": "cpu", "threads": 3},
+               "far_field_theta": 0.5, "backend": "cpu", "threads": 3},
     "simulation": {"time_step": 0.001, "duration": 1.5, "frame_rate": 60, "solver_iterations": 20,
                    "ground": false, "ground_height": -0.1,
                    "contact": {"friction": 0.3, "restitution": 0.5, "softness": 0, "erp": 0.8,
@@ -154,6 +154,7 @@ TEST(SceneParser, AllSettings) {
   EXPECT_FALSE(s.solver.relax.mutual_induction);
   EXPECT_EQ(s.solver.relax.local.time_step_factor, 0.3);
   EXPECT_EQ(s.solver.relax.local.noise_ratio, 0.0);
+  EXPECT_EQ(s.solver.relax.far_field_theta, 0.5);
   EXPECT_EQ(s.solver.backend, "cpu");
   EXPECT_EQ(s.solver.threads, 3);
   EXPECT_EQ(s.simulation.time_step, 0.001);
@@ -401,6 +402,8 @@ TEST(SceneParser, RejectsOutOfRangeSettings) {
   expect_key(scene_with(R"("cell_size": -0.001)"), "cell_size");
   expect_key(scene_with(R"("solver": {"tolerance": 0})"), "solver.tolerance");
   expect_key(scene_with(R"("solver": {"backend": "gpu"})"), "solver.backend");
+  expect_key(scene_with(R"("solver": {"far_field_theta": 1})"), "solver.far_field_theta");
+  expect_key(scene_with(R"("solver": {"far_field_theta": -0.5})"), "solver.far_field_theta");
   expect_key(scene_with(R"("simulation": {"contact": {"restitution": 1.5}})"), "simulation.contact.restitution");
   expect_key(scene_with(R"("simulation": {"max_substeps": 0})"), "simulation.max_substeps");
   expect_key(scene_with(R"("simulation": {"stiffness_limit": 0})"), "simulation.stiffness_limit");

@@ -1,0 +1,61 @@
+// Small pieces shared by the benchmark programs.
+#pragma once
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "magnetics/material.h"
+#include "magnetics/model.h"
+#include "magnetics/rng.h"
+#include "magnetics/state.h"
+
+namespace odemag::bench {
+
+// Runs the program again with OMP_WAIT_POLICY=passive when that is unset:
+// sleeping instead of spinning OpenMP threads, since on a machine shared with
+// other jobs spinning barriers slow small two-thread runs many times
+// (docs/benchmarks.md "Threads and waiting").
+inline void restart_with_passive_omp(char** argv) {
+  if (!std::getenv("OMP_WAIT_POLICY")) {
+    setenv("OMP_WAIT_POLICY", "passive", 1);
+    execv("/proc/self/exe", argv);
+  }
+}
+
+// "a,b,c" -> {"a", "b", "c"}.
+inline std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) out.push_back(item);
+  return out;
+}
+
+// N soft one-cell steel balls (R = 5 mm, chi 1000, Ms 1.6e6 A/m) scattered in
+// a cube of side 11 mm x N^(1/3), magnetized randomly (5e5 A/m): a crane heap
+// for the pair kernels.
+struct BallHeap {
+  MagneticModel model;
+  MagneticState state;
+  explicit BallHeap(int n) {
+    SoftMaterial steel;
+    steel.saturation = 1.6e6;
+    steel.susceptibility = 1000;
+    const double side = 0.011 * std::cbrt(static_cast<double>(n));
+    for (int i = 0; i < n; ++i) model.add_body(std::to_string(i), Sphere{0.005}, steel, 0.0);
+    state = make_state(model, 5);
+    for (int i = 0; i < n; ++i) {
+      state.pose[i].position = side * Vec3{unit_interval(hash_key(1, i, 0, 0)), unit_interval(hash_key(1, i, 1, 0)),
+                                           unit_interval(hash_key(1, i, 2, 0))};
+      state.magnetization[i] = 5e5 * random_unit_vector(hash_key(2, i, 0, 0));
+    }
+    for (int i = 0; i < n; ++i) state.cell_position[i] = state.pose[i].position;
+  }
+};
+
+}  // namespace odemag::bench
