@@ -472,8 +472,8 @@ BodyDescription read_body(const SceneReader& r, const json& v, const std::string
 
 SolverSettings read_solver(const SceneReader& r, const json& v, const std::string& path) {
   r.check_keys(v, path, {"scheme", "tolerance", "max_iterations", "anderson_depth", "mixing",
-                         "mutual_induction", "time_step_factor", "noise", "far_field_theta", "backend",
-                         "threads"});
+                         "mutual_induction", "time_step_factor", "noise", "far_field_theta",
+                         "skip_unchanged", "backend", "threads"});
   SolverSettings s;
   RelaxOptions& o = s.relax;
   r.optional(v, "scheme", path, [&](const json& x, const std::string& p) {
@@ -492,6 +492,8 @@ SolverSettings read_solver(const SceneReader& r, const json& v, const std::strin
              [&](const json& x, const std::string& p) { o.local.time_step_factor = r.positive(x, p); });
   r.optional(v, "noise", path,
              [&](const json& x, const std::string& p) { o.local.noise_ratio = r.non_negative(x, p); });
+  r.optional(v, "skip_unchanged", path,
+             [&](const json& x, const std::string& p) { o.skip_unchanged = r.boolean(x, p); });
   r.optional(v, "far_field_theta", path, [&](const json& x, const std::string& p) {
     o.far_field_theta = r.in_range(x, p, 0.0, 0.9);
   });

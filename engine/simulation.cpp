@@ -222,6 +222,7 @@ void Simulation::step() {
     record.magnetic_ms += elapsed_ms(t0);
     const RelaxReport& report = magnetics_->last_report();
     record.iterations += report.iterations;
+    record.skipped += report.skipped ? 1 : 0;
     record.converged = record.converged && report.converged;
     record.residual = std::max(record.residual, report.residual);
   };

@@ -206,10 +206,54 @@ RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxO
   return report;
 }
 
+namespace {
+
+// skip_unchanged: a magnetic body may move this fraction of its cell contact
+// radius, and turn this many radians, from the pose last solved for.
+constexpr double kUnchangedDistance = 1e-5, kUnchangedRotation = 1e-5;
+
+bool unchanged_since_last_solve(const MagneticModel& model, const MagneticState& state, const RelaxOptions& o) {
+  const SolvedInputs& last = state.last_solve;
+  const size_t bodies = static_cast<size_t>(model.body_count());
+  if (!last.valid || last.pose.size() != bodies || last.active != state.active ||
+      last.magnetization_scale != state.magnetization_scale || last.mutual_induction != o.mutual_induction ||
+      last.far_field_theta != o.far_field_theta || norm(last.external_field - state.external_field) != 0.0)
+    return false;
+  for (int b = 0; b < model.body_count(); ++b) {
+    const MagneticBody& body = model.body(b);
+    if (body.inert() || !state.active[b]) continue;
+    const BodyPose &p = state.pose[b], &q = last.pose[b];
+    if (norm(p.position - q.position) > kUnchangedDistance * body.cells.contact_radius) return false;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (std::fabs(p.rotation.m[i][j] - q.rotation.m[i][j]) > kUnchangedRotation) return false;
+  }
+  return true;
+}
+
+void record_solve(MagneticState& state, const RelaxOptions& o, bool converged) {
+  SolvedInputs& last = state.last_solve;
+  last.valid = converged;
+  last.pose = state.pose;
+  last.active = state.active;
+  last.magnetization_scale = state.magnetization_scale;
+  last.external_field = state.external_field;
+  last.mutual_induction = o.mutual_induction;
+  last.far_field_theta = o.far_field_theta;
+}
+
+}  // namespace
+
 RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
                           const RelaxOptions& options, MagneticBackend& backend) {
+  if (options.skip_unchanged && unchanged_since_last_solve(model, state, options)) {
+    RelaxReport skipped;
+    skipped.converged = skipped.skipped = true;
+    return skipped;
+  }
   RelaxReport report = relax(model, state, options, backend);
   backend.forces(model, state);
+  record_solve(state, options, report.converged);
   return report;
 }
 

@@ -40,6 +40,12 @@ struct RelaxOptions {
   // (docs/model.md "Far field"; CPU backend, 512 responsive cells or more):
   // 0 sums every pair exactly; the error falls as theta^2.
   double far_field_theta = 0.0;
+  // magnetic_step returns at once, keeping the magnetization, forces and
+  // torques, when nothing changed since the last converged step: the same
+  // active bodies, magnetization scales, H_E and options, and every magnetic
+  // body within 1e-5 of its cell radius and 1e-5 rad of the pose then solved
+  // (docs/model.md "Skipping unchanged steps").
+  bool skip_unchanged = false;
   LocalRelaxOptions local;
 };
 
@@ -48,6 +54,7 @@ struct RelaxReport {
   int field_evaluations = 0;  // responsive-field evaluations, O(N^2) each
   double residual = 0.0;      // final value of the convergence measure
   bool converged = false;
+  bool skipped = false;       // skip_unchanged: nothing changed, nothing computed
   long llg_steps = 0;         // per-cell LLG steps, summed over cells
   long newton_steps = 0;      // per-cell Newton steps, summed over cells
   std::vector<double> residual_history;  // the convergence measure after each iteration

@@ -5,6 +5,7 @@
 namespace odemag {
 
 void reset_moments(const MagneticModel& model, MagneticState& state, int b) {
+  state.last_solve.valid = false;
   const MagneticBody& body = model.body(b);
   if (body.kind != CellKind::soft) return;
   for (int i = 0; i < body.cell_count(); ++i) {

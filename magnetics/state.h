@@ -14,6 +14,17 @@ struct BodyPose {
   Vec3 position;  // centre of mass, world, m
 };
 
+// What the last converged magnetic step solved for (RelaxOptions::skip_unchanged).
+struct SolvedInputs {
+  bool valid = false;
+  std::vector<BodyPose> pose;
+  std::vector<uint8_t> active;
+  std::vector<double> magnetization_scale;
+  Vec3 external_field;
+  bool mutual_induction = true;
+  double far_field_theta = 0.0;
+};
+
 struct MagneticState {
   Vec3 external_field;  // uniform H_E, A/m
 
@@ -36,6 +47,10 @@ struct MagneticState {
   std::vector<Vec3> moment_hc_prev;  // Hc^(i-1) for the extrapolation
 
   uint64_t seed = 1;
+
+  // Inputs of the last converged magnetic step; invalidate (valid = false)
+  // after editing moments or magnetizations by hand.
+  SolvedInputs last_solve;
 };
 
 // A state for the model: identity poses at the origin, all bodies active,

@@ -143,13 +143,14 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
 
   // summary.json: the cost of every rigid step and the scene's outcomes.
   std::vector<double> tm, tr, iterations, substeps;
-  long not_converged = 0;
+  long not_converged = 0, skipped = 0;
   for (const StepRecord& r : sim.records()) {
     tm.push_back(r.magnetic_ms);
     tr.push_back(r.rigid_ms);
     iterations.push_back(r.iterations);
     substeps.push_back(r.substeps);
     if (!r.converged) ++not_converged;
+    skipped += r.skipped;
   }
   const MagneticModel& model = sim.magnetics().model();
   json outcomes = json::object();
@@ -172,6 +173,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
       {"iterations", statistics(iterations)},
       {"substeps", statistics(substeps)},  // one relaxation per substep
       {"steps_not_converged", not_converged},
+      {"magnetic_steps_skipped", skipped},  // substeps, with solver.skip_unchanged
       {"outcomes", outcomes},
   };
   write_file_atomically((dir / "summary.json").string(), summary.dump(2) + "\n");
