@@ -253,7 +253,12 @@ RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
   }
   RelaxReport report = relax(model, state, options, backend);
   backend.forces(model, state);
-  record_solve(state, options, report.converged);
+  // Only a run that skips pays for remembering what it solved.
+  if (options.skip_unchanged) {
+    record_solve(state, options, report.converged);
+  } else {
+    state.last_solve.valid = false;
+  }
   return report;
 }
 
