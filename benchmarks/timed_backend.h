@@ -18,6 +18,7 @@ class TimedBackend final : public MagneticBackend {
   explicit TimedBackend(std::unique_ptr<MagneticBackend> inner) : inner_(std::move(inner)) {}
   std::string name() const override { return inner_->name(); }
   void set_far_field(double theta) override { inner_->set_far_field(theta); }
+  void set_near_field(bool on, bool mutual_induction) override { inner_->set_near_field(on, mutual_induction); }
   void begin_step(const MagneticModel& m, const MagneticState& s) override {
     timed(begin_s, [&] { inner_->begin_step(m, s); });
   }

@@ -473,7 +473,7 @@ BodyDescription read_body(const SceneReader& r, const json& v, const std::string
 SolverSettings read_solver(const SceneReader& r, const json& v, const std::string& path) {
   r.check_keys(v, path, {"scheme", "tolerance", "max_iterations", "anderson_depth", "mixing",
                          "mutual_induction", "time_step_factor", "noise", "far_field_theta",
-                         "skip_unchanged", "backend", "threads"});
+                         "skip_unchanged", "near_field", "backend", "threads"});
   SolverSettings s;
   RelaxOptions& o = s.relax;
   r.optional(v, "scheme", path, [&](const json& x, const std::string& p) {
@@ -494,6 +494,8 @@ SolverSettings read_solver(const SceneReader& r, const json& v, const std::strin
              [&](const json& x, const std::string& p) { o.local.noise_ratio = r.non_negative(x, p); });
   r.optional(v, "skip_unchanged", path,
              [&](const json& x, const std::string& p) { o.skip_unchanged = r.boolean(x, p); });
+  r.optional(v, "near_field", path,
+             [&](const json& x, const std::string& p) { o.near_field = r.boolean(x, p); });
   r.optional(v, "far_field_theta", path, [&](const json& x, const std::string& p) {
     o.far_field_theta = r.in_range(x, p, 0.0, 0.9);
   });

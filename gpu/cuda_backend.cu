@@ -33,6 +33,7 @@
 #include "gpu/device_buffer.cuh"
 #include "gpu/device_data.cuh"
 #include "magnetics/field_probe.h"
+#include "magnetics/near_field.h"
 
 namespace odemag {
 
@@ -264,9 +265,17 @@ class CudaBackend final : public MagneticBackend {
     timer.uploads_done();
     timer.synchronize(up, 0.0);
     timer.stop();
+    // Near-field corrections: short pair lists, evaluated on the host with
+    // the same code as the CPU backend (magnetics/near_field.h).
+    near_.build(model, state, near_field_, near_mutual_induction_);
   }
 
-  void fixed_field(const MagneticModel&, const MagneticState& state, std::vector<Vec3>& H) override {
+  void set_near_field(bool on, bool mutual_induction) override {
+    near_field_ = on;
+    near_mutual_induction_ = mutual_induction;
+  }
+
+  void fixed_field(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& H) override {
     const int n = responsive_count();
     if (n == 0) return;
     select(device_);
@@ -282,10 +291,11 @@ class CudaBackend final : public MagneticBackend {
     resp_H_.download(pin_out_.data(), n, stream());
     timer.synchronize(0.0, bytes_of<Vec3>(n));
     for (int i = 0; i < n; ++i) H[resp_cells_[i]] = pin_out_[i];
+    near_.add_field(model, state, NearFieldSources::fixed, H);
     timer.stop();
   }
 
-  void responsive_field(const MagneticModel&, const MagneticState& state,
+  void responsive_field(const MagneticModel& model, const MagneticState& state,
                         std::vector<Vec3>& H) override {
     const int n = responsive_count();
     if (n == 0) return;
@@ -310,6 +320,7 @@ class CudaBackend final : public MagneticBackend {
     resp_H_.download(pin_out_.data(), n, s);
     timer.synchronize(bytes_of<Vec3>(n), bytes_of<Vec3>(n));
     for (int i = 0; i < n; ++i) H[resp_cells_[i]] = pin_out_[i];
+    near_.add_field(model, state, NearFieldSources::responsive, H);
     timer.stop();
   }
 
@@ -391,6 +402,15 @@ class CudaBackend final : public MagneticBackend {
     all_force_.download(pin_out_.data(), n, s);
     all_field_.download(pin_out2_.data(), n, s);
     timer.synchronize(bytes_of<Vec3>(n), 2 * bytes_of<Vec3>(n));
+    if (near_.pair_count() > 0) {
+      near_force_.assign(model.cell_count(), {});
+      near_field_at_.assign(model.cell_count(), {});
+      near_.add_forces(model, state, near_force_, near_field_at_);
+      for (int i = 0; i < n; ++i) {
+        pin_out_[i] += near_force_[all_cells_[i]];
+        pin_out2_[i] += near_field_at_[all_cells_[i]];
+      }
+    }
     // Per-body sums in cell order, as the CPU backend.
     for (int i = 0; i < n; ++i) {
       const int b = all_bodies_[i];
@@ -458,6 +478,9 @@ class CudaBackend final : public MagneticBackend {
   }
 
   int device_;
+  bool near_field_ = true, near_mutual_induction_ = true;
+  NearField near_;
+  std::vector<Vec3> near_force_, near_field_at_;
   Stream stream_;
   std::array<Event, 4> events_;
   CudaBackendStats stats_;

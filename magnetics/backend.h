@@ -36,6 +36,11 @@ class MagneticBackend {
   // pair exactly. A backend without the approximation always sums exactly.
   virtual void set_far_field(double theta) { (void)theta; }
 
+  // Near-field corrections between touching bodies (magnetics/near_field.h),
+  // taking effect at the next begin_step: on = false keeps the point dipoles
+  // of the paper's model; mutual_induction as RelaxOptions::mutual_induction.
+  virtual void set_near_field(bool on, bool mutual_induction) = 0;
+
   // H_E plus the field of every fixed permanent cell, at each active
   // responsive cell. Constant during a relaxation.
   virtual void fixed_field(const MagneticModel& model, const MagneticState& state,
@@ -43,7 +48,7 @@ class MagneticBackend {
 
   // Field of the responsive cells (their state.magnetization) at each active
   // responsive cell: the intra-body part from the cached tensors, the
-  // inter-body part from the dipole kernel. sources_soft: include soft cells as sources.
+  // inter-body part from the dipole kernel and the near-field corrections.
   virtual void responsive_field(const MagneticModel& model, const MagneticState& state,
                                 std::vector<Vec3>& H) = 0;
 

@@ -8,6 +8,7 @@
 #include "magnetics/far_field.h"
 #include "magnetics/field_probe.h"
 #include "magnetics/kernels.h"
+#include "magnetics/near_field.h"
 #include "magnetics/pair_sums.h"
 #include "magnetics/simd.h"
 
@@ -38,7 +39,7 @@ struct CellArrays {
   void push(const MagneticModel& model, const MagneticState& state, int c) {
     const Vec3& p = state.cell_position[c];
     x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
-    radius.push_back(model.body(model.cell_body(c)).cells.contact_radius);
+    radius.push_back(model.cell_contact_radius(c));
     mx.push_back(0), my.push_back(0), mz.push_back(0);
     cell.push_back(c);
     body.push_back(model.cell_body(c));
@@ -48,7 +49,7 @@ struct CellArrays {
   }
   void load_moments(const MagneticModel& model, const MagneticState& state) {
     for (int i = 0; i < size(); ++i) {
-      const Vec3 mu = model.body(body[i]).cells.cell_volume * state.magnetization[cell[i]];
+      const Vec3 mu = model.cell_volume(cell[i]) * state.magnetization[cell[i]];
       mx[i] = mu.x, my[i] = mu.y, mz[i] = mu.z;
     }
   }
@@ -147,17 +148,23 @@ class CpuBackend final : public MagneticBackend {
     if (use_tree_)
       tree_.build(resp_.x.data(), resp_.y.data(), resp_.z.data(), resp_.radius.data(), resp_.body.data(),
                   resp_.size(), far_field_theta_);
+    near_.build(model, state, near_field_, near_mutual_induction_);
   }
 
   void set_far_field(double theta) override { far_field_theta_ = theta; }
+  void set_near_field(bool on, bool mutual_induction) override {
+    near_field_ = on;
+    near_mutual_induction_ = mutual_induction;
+  }
 
-  void fixed_field(const MagneticModel&, const MagneticState& state, std::vector<Vec3>& H) override {
+  void fixed_field(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& H) override {
     const int n = resp_.size();
 #pragma omp parallel for schedule(static) num_threads(threads_) if (static_cast<long>(n) * fixed_.size() > kParallelPairs)
     for (int i = 0; i < n; ++i)
       H[resp_.cell[i]] = state.external_field +
                          sum_field(fixed_.sources(), 0, fixed_.size(), resp_.x[i], resp_.y[i], resp_.z[i],
                                    resp_.radius[i]);
+    near_.add_field(model, state, NearFieldSources::fixed, H);
   }
 
   void responsive_field(const MagneticModel& model, const MagneticState& state,
@@ -195,6 +202,7 @@ class CpuBackend final : public MagneticBackend {
       }
       H[resp_.cell[i]] = h;
     }
+    near_.add_field(model, state, NearFieldSources::responsive, H);
   }
 
   LocalStats relax_cells(const MagneticModel& model, MagneticState& state,
@@ -242,6 +250,15 @@ class CpuBackend final : public MagneticBackend {
       cell_force_[i] = a.force + b.force;
       cell_field_[i] = a.field + b.field;
     }
+    if (near_.pair_count() > 0) {
+      near_force_.assign(model.cell_count(), {});
+      near_field_at_.assign(model.cell_count(), {});
+      near_.add_forces(model, state, near_force_, near_field_at_);
+      for (int i = 0; i < n; ++i) {
+        cell_force_[i] += near_force_[all_.cell[i]];
+        cell_field_[i] += near_field_at_[all_.cell[i]];
+      }
+    }
     std::fill(state.force.begin(), state.force.end(), Vec3{});
     std::fill(state.torque.begin(), state.torque.end(), Vec3{});
     for (int i = 0; i < n; ++i) {
@@ -271,7 +288,9 @@ class CpuBackend final : public MagneticBackend {
   CellArrays fixed_, resp_, all_;
   std::vector<std::pair<int, int>> resp_range_;  // per responsive cell: its body's range in resp_
   std::vector<std::pair<int, int>> all_range_;   // per cell: its body's range in all_
-  std::vector<Vec3> body_moment_, cell_force_, cell_field_;
+  std::vector<Vec3> body_moment_, cell_force_, cell_field_, near_force_, near_field_at_;
+  bool near_field_ = true, near_mutual_induction_ = true;
+  NearField near_;
   double far_field_theta_ = 0.0;  // 0: every pair summed exactly
   bool use_tree_ = false;
   FarFieldTree tree_;

@@ -50,6 +50,70 @@ double second_differences(F fn, double X, double Y, double Z, double h) {
   return s;
 }
 
+// f and g with their first derivatives at one point, sharing the
+// transcendental terms. With v = (|x|, |y|, |z|), R = |v| and, per axis k
+// with the other two axes i, j: L_k = asinh(v_k / sqrt(v_i^2 + v_j^2)) and
+// A_k = atan(v_i v_j / (v_k R)) (each 0 where its denominator vanishes, as
+// the guards in newell_f and newell_g drop those terms). Then f(p_i, p_j, p_k)
+// and g(p_i, p_j, p_k) for any order
+// (i, j, k) of the axes, and their derivatives (derived symbolically from f
+// and g above; the test checks them against central differences).
+struct NewellPoint {
+  double v[3], s[3], R, L[3], A[3];
+
+  NewellPoint(double x, double y, double z) {
+    const double p[3] = {x, y, z};
+    for (int k = 0; k < 3; ++k) v[k] = std::fabs(p[k]), s[k] = p[k] < 0.0 ? -1.0 : (p[k] > 0.0 ? 1.0 : 0.0);
+    R = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; ++k) {
+      const double a = v[(k + 1) % 3], b = v[(k + 2) % 3];
+      const double rho2 = a * a + b * b;
+      L[k] = rho2 > 0.0 ? std::asinh(v[k] / std::sqrt(rho2)) : 0.0;
+      A[k] = v[k] > 0.0 ? std::atan(a * b / (v[k] * R)) : 0.0;
+    }
+  }
+  // Newell's f and g of the positive octant, arguments (v_i, v_j, v_k).
+  double F(int i, int j, int k) const {
+    const double a = v[i], b = v[j], c = v[k];
+    return (2.0 * a * a - b * b - c * c) * R / 6.0 + 0.5 * b * (c * c - a * a) * L[j] +
+           0.5 * c * (b * b - a * a) * L[k] - a * b * c * A[i];
+  }
+  double G(int i, int j, int k) const {
+    const double a = v[i], b = v[j], c = v[k];
+    return -a * b * R / 3.0 + a * b * c * L[k] + b / 6.0 * (3.0 * c * c - b * b) * L[i] +
+           a / 6.0 * (3.0 * c * c - a * a) * L[j] - c * c * c / 6.0 * A[k] - 0.5 * c * b * b * A[j] -
+           0.5 * c * a * a * A[i];
+  }
+  // dF/dv_i, dF/dv_j (= dG/dv_i) and dG/dv_k.
+  double Fi(int i, int j, int k) const {
+    const double a = v[i], b = v[j], c = v[k];
+    return a * R - a * b * L[j] - a * c * L[k] - b * c * A[i];
+  }
+  double Fj(int i, int j, int k) const {
+    const double a = v[i], b = v[j], c = v[k];
+    return -0.5 * b * R + 0.5 * (c * c - a * a) * L[j] + b * c * L[k] - a * c * A[i];
+  }
+  double Gk(int i, int j, int k) const {
+    const double a = v[i], b = v[j], c = v[k];
+    return a * b * L[k] + a * c * L[j] + b * c * L[i] - 0.5 * (a * a * A[i] + b * b * A[j] + c * c * A[k]);
+  }
+  // The signed functions: f (even in each argument) and g (odd in the first
+  // two) of (p_i, p_j, p_k), and their gradients along (p_i, p_j, p_k); at a
+  // kink (an argument exactly 0) the mean of the two sides (s = 0 there).
+  double f(int i, int j, int k, double grad[3]) const {
+    grad[0] = s[i] * Fi(i, j, k);
+    grad[1] = s[j] * Fj(i, j, k);
+    grad[2] = s[k] * Fj(i, k, j);  // f is symmetric in its last two arguments
+    return F(i, j, k);
+  }
+  double g(int i, int j, int k, double grad[3]) const {
+    grad[0] = s[j] * Fj(i, j, k);  // dg/dx = df/dy
+    grad[1] = s[i] * Fj(j, i, k);  // g is symmetric in its first two arguments
+    grad[2] = s[i] * s[j] * s[k] * Gk(i, j, k);
+    return s[i] * s[j] * G(i, j, k);
+  }
+};
+
 }  // namespace
 
 void cube_demag_tensor(int i, int j, int k, double h, double n[6]) {
@@ -82,6 +146,74 @@ void cube_demag_tensor(int i, int j, int k, double h, double n[6]) {
   n[1] *= sx * sy;
   n[2] *= sx * sz;
   n[4] *= sy * sz;
+}
+
+void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)[6]) {
+  const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  const double range = kNewellRange * h;
+  if (r2 > range * range) {
+    // Point dipole: n = -h^3 T(d), T = A I + B d d^T, dT_ab/dd_k = B (d_k delta_ab
+    // + delta_ak d_b + delta_bk d_a) + C d_k d_a d_b (magnetics/kernels.h).
+    const Vec3 r{d[0], d[1], d[2]};
+    double t[6];
+    dipole_tensor(r, 0.0, t);
+    const double h3 = h * h * h;
+    for (int a = 0; a < 6; ++a) n[a] = -t[a] * h3;
+    if (dn) {
+      const DipoleCoefficients c = dipole_coefficients(r2, 0.0);
+      static constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+      for (int k = 0; k < 3; ++k)
+        for (int m = 0; m < 6; ++m) {
+          const int a = row[m], b = col[m];
+          double v = c.C * d[k] * d[a] * d[b];
+          if (a == b) v += c.B * d[k];
+          if (a == k) v += c.B * d[b];
+          if (b == k) v += c.B * d[a];
+          dn[k][m] = -h3 * v;
+        }
+    }
+    return;
+  }
+  // As cube_demag_tensor: the 27-point second differences at |d|, then the
+  // signs of the components odd in an axis restored. Component m is f (xx,
+  // yy, zz) or g (xy, xz, yz) with its arguments in the order order[m].
+  static constexpr int order[6][3] = {{0, 1, 2}, {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 1, 0}};
+  static constexpr bool is_f[6] = {true, false, false, true, false, true};
+  static constexpr int odd[6][3] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, {0, 0, 0}, {0, 1, 1}, {0, 0, 0}};
+  static constexpr double w[3] = {-1.0, 2.0, -1.0};
+  const double sign[3] = {d[0] < 0.0 ? -1.0 : (d[0] > 0.0 ? 1.0 : 0.0), d[1] < 0.0 ? -1.0 : (d[1] > 0.0 ? 1.0 : 0.0),
+                          d[2] < 0.0 ? -1.0 : (d[2] > 0.0 ? 1.0 : 0.0)};
+  const double X = std::fabs(d[0]), Y = std::fabs(d[1]), Z = std::fabs(d[2]);
+  double u[6] = {}, du[3][6] = {};  // the tensor at |d| and its gradient
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      for (int e = 0; e < 3; ++e) {
+        const double wt = w[a] * w[b] * w[e];
+        const NewellPoint pt(X + (a - 1) * h, Y + (b - 1) * h, Z + (e - 1) * h);
+        for (int m = 0; m < 6; ++m) {
+          const int* o = order[m];
+          double g[3];
+          u[m] += wt * (is_f[m] ? pt.f(o[0], o[1], o[2], g) : pt.g(o[0], o[1], o[2], g));
+          if (dn)
+            for (int q = 0; q < 3; ++q) du[o[q]][m] += wt * g[q];
+        }
+      }
+  const double c = 1.0 / (4.0 * kPi * h * h * h);
+  for (int m = 0; m < 6; ++m) {
+    n[m] = c * u[m];
+    for (int k = 0; k < 3; ++k)
+      if (odd[m][k]) n[m] *= sign[k];
+  }
+  if (!dn) return;
+  // d/dd_k of a component restored with signs: axis k's sign moves from the
+  // odd components to the even ones.
+  for (int k = 0; k < 3; ++k)
+    for (int m = 0; m < 6; ++m) {
+      double v = c * du[k][m];
+      for (int j = 0; j < 3; ++j)
+        if ((j == k) != (odd[m][j] != 0)) v *= sign[j];
+      dn[k][m] = v;
+    }
 }
 
 }  // namespace odemag

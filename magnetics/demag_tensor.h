@@ -26,4 +26,15 @@ void cube_demag_tensor(int i, int j, int k, double h, double n[6]);
 
 inline constexpr int kNewellRange = 16;
 
+// The same tensor at a real-valued offset d = centre of a - centre of b (m),
+// for cubes that are aligned but need not share a lattice (cells of two
+// bodies whose lattices are parallel), and, when dn is not null, its gradient
+// dn[k][c] = dN_c / dd_k (1/m) from the derivatives of Newell's f and g. At
+// integer offsets it equals cube_demag_tensor to round-off (1e-14). N is continuous
+// everywhere, even for overlapping cubes, and N(-d) = N(d); its gradient is
+// continuous except where faces of the two cubes pass through each other
+// (|d_k| = h with overlapping projections, and d_k = 0 for overlapping cubes),
+// where the two-sided mean is returned. Beyond kNewellRange cells: the point dipole.
+void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)[6] = nullptr);
+
 }  // namespace odemag

@@ -71,6 +71,9 @@ class MagneticModel {
 
   int cell_count() const { return static_cast<int>(cell_body_.size()); }
   int cell_body(int c) const { return cell_body_[c]; }
+  // Volume (m^3) a cell stands for, and its contact radius (m; CellSet).
+  double cell_volume(int c) const { return bodies_[cell_body_[c]].cells.cell_volume; }
+  double cell_contact_radius(int c) const { return bodies_[cell_body_[c]].cells.contact_radius; }
   // Index of the cell's first moment in the state's moment array, -1 if not soft.
   int moment_offset(int c) const { return moment_offset_[c]; }
   int moment_count() const { return moment_count_; }

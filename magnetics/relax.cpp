@@ -6,6 +6,7 @@
 
 #include "magnetics/anderson.h"
 #include "magnetics/kernels.h"
+#include "magnetics/near_field.h"
 
 namespace odemag {
 
@@ -80,6 +81,7 @@ RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxO
                   MagneticBackend& backend) {
   place_cells(model, state);
   backend.set_far_field(o.far_field_theta);
+  backend.set_near_field(o.near_field, o.mutual_induction);
   backend.begin_step(model, state);
   const std::vector<int> cells = active_responsive_cells(model, state);
   if (cells.empty()) {
@@ -217,7 +219,7 @@ bool unchanged_since_last_solve(const MagneticModel& model, const MagneticState&
   const size_t bodies = static_cast<size_t>(model.body_count());
   if (!last.valid || last.pose.size() != bodies || last.active != state.active ||
       last.magnetization_scale != state.magnetization_scale || last.mutual_induction != o.mutual_induction ||
-      last.far_field_theta != o.far_field_theta || norm(last.external_field - state.external_field) != 0.0)
+      last.far_field_theta != o.far_field_theta || last.near_field != o.near_field || norm(last.external_field - state.external_field) != 0.0)
     return false;
   for (int b = 0; b < model.body_count(); ++b) {
     const MagneticBody& body = model.body(b);
@@ -240,6 +242,7 @@ void record_solve(MagneticState& state, const RelaxOptions& o, bool converged) {
   last.external_field = state.external_field;
   last.mutual_induction = o.mutual_induction;
   last.far_field_theta = o.far_field_theta;
+  last.near_field = o.near_field;
 }
 
 }  // namespace
@@ -288,27 +291,28 @@ void field_at_points(const MagneticModel& model, const MagneticState& state,
   }
 }
 
-double magnetic_energy(const MagneticModel& model, const MagneticState& state) {
-  double e = 0.0;
+double magnetic_energy(const MagneticModel& model, const MagneticState& state, bool near_field) {
+  NearField near;
+  near.build(model, state, near_field);
+  double e = near.energy(model, state);
   const int n = model.cell_count();
   for (int a = 0; a < n; ++a) {
     const int ba = model.cell_body(a);
     if (!state.active[ba]) continue;
     const MagneticBody& body_a = model.body(ba);
-    const Vec3 mu_a = body_a.cells.cell_volume * state.magnetization[a];
+    const Vec3 mu_a = model.cell_volume(a) * state.magnetization[a];
     e -= kMu0 * dot(mu_a, state.external_field);
     for (int b = a + 1; b < n; ++b) {
       const int bb = model.cell_body(b);
       if (!state.active[bb]) continue;
-      const MagneticBody& body_b = model.body(bb);
-      const Vec3 mu_b = body_b.cells.cell_volume * state.magnetization[b];
-      const double s = ba == bb ? 0.0 : body_a.cells.contact_radius + body_b.cells.contact_radius;
+      const Vec3 mu_b = model.cell_volume(b) * state.magnetization[b];
+      const double s = ba == bb ? 0.0 : model.cell_contact_radius(a) + model.cell_contact_radius(b);
       e += dipole_energy(state.cell_position[b] - state.cell_position[a], mu_a, mu_b, s * s);
     }
     if (body_a.kind == CellKind::soft) {
       // Self energy mu0 V (gamma_D Ms^2 |mean m|^2 / 2 + anisotropy).
       SoftCellParams p = body_a.soft;
-      e += kMu0 * body_a.cells.cell_volume * p.Ms *
+      e += kMu0 * model.cell_volume(a) * p.Ms *
            cell_free_energy(p, Vec3{}, &state.moments[model.moment_offset(a)]);
     }
   }

@@ -46,6 +46,10 @@ struct RelaxOptions {
   // body within 1e-5 of its cell radius and 1e-5 rad of the pose then solved
   // (docs/model.md "Skipping unchanged steps").
   bool skip_unchanged = false;
+  // Near-field corrections where bodies touch (docs/model.md "The near
+  // field"): induced higher multipoles of one-cell spheres, cell-averaged
+  // coupling of aligned lattice cells. false: point dipoles only (the paper).
+  bool near_field = true;
   LocalRelaxOptions local;
 };
 
@@ -80,6 +84,7 @@ void field_at_points(const MagneticModel& model, const MagneticState& state,
 // Total magnetic energy (J) of the configuration with the current
 // magnetizations: pair interactions, H_E and, for soft cells, the cell free
 // energies. Used by tests (App. B) and diagnostics.
-double magnetic_energy(const MagneticModel& model, const MagneticState& state);
+// near_field: include the near-field corrections (magnetics/near_field.h).
+double magnetic_energy(const MagneticModel& model, const MagneticState& state, bool near_field = true);
 
 }  // namespace odemag

@@ -23,6 +23,7 @@ struct SolvedInputs {
   Vec3 external_field;
   bool mutual_induction = true;
   double far_field_theta = 0.0;
+  bool near_field = true;
 };
 
 struct MagneticState {

@@ -130,7 +130,8 @@ TEST(SceneParser, AllSettings) {
     "title": "all", "seed": 42, "external_field": [1, 2, 3],
     "solver": {"scheme": "paper", "tolerance": 1e-5, "max_iterations": 50, "anderson_depth": 0,
                "mixing": 0.5, "mutual_induction": false, "time_step_factor": 0.3, "noise": 0,
-               "far_field_theta": 0.5, "skip_unchanged": true, "backend": "cpu", "threads": 3},
+               "far_field_theta": 0.5, "skip_unchanged": true, "near_field": false, "backend": "cpu",
+               "threads": 3},
     "simulation": {"time_step": 0.001, "duration": 1.5, "frame_rate": 60, "solver_iterations": 20,
                    "ground": false, "ground_height": -0.1,
                    "contact": {"friction": 0.3, "restitution": 0.5, "softness": 0, "erp": 0.8,
@@ -156,6 +157,7 @@ TEST(SceneParser, AllSettings) {
   EXPECT_EQ(s.solver.relax.local.noise_ratio, 0.0);
   EXPECT_EQ(s.solver.relax.far_field_theta, 0.5);
   EXPECT_TRUE(s.solver.relax.skip_unchanged);
+  EXPECT_FALSE(s.solver.relax.near_field);
   EXPECT_EQ(s.solver.backend, "cpu");
   EXPECT_EQ(s.solver.threads, 3);
   EXPECT_EQ(s.simulation.time_step, 0.001);

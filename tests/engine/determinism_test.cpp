@@ -12,6 +12,11 @@
 // hash it computed, while the run-to-run and thread-count tests still run.
 // After a deliberate change, run build/bin/engine_determinism_test and copy
 // the hashes it prints here.
+//
+// Re-pinned (stop 11) for the near field (solver.near_field, default on:
+// the higher multipoles of one-cell spheres and the cell-averaged coupling
+// of aligned lattices between bodies, docs/model.md "The near field"): every
+// pinned scene has close ball pairs or touching lattice bodies.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -72,10 +77,10 @@ struct Case {
 };
 
 const Case kCases[] = {
-    {"ball_chain", 1.5, 0x04df07a00a2b246aULL},
-    {"iron_plate", 1.7, 0x971cb49f1bdc6af1ULL},
-    {"thin_iron_plate", 1.0, 0xf2e198221985e4d6ULL},
-    {"nail_and_balls", 3.2, 0x350608447596807fULL},
+    {"ball_chain", 1.5, 0x35735c4d0141f98aULL},
+    {"iron_plate", 1.7, 0xe4aac92123770948ULL},
+    {"thin_iron_plate", 1.0, 0xe147c7be557853f3ULL},
+    {"nail_and_balls", 3.2, 0xed90b9774570b968ULL},
 };
 
 // Set by tests/engine/CMakeLists.txt for a Release build with

@@ -22,6 +22,7 @@
 #include "engine/simulation.h"
 #include "magnetics/constants.h"
 #include "magnetics/kernels.h"
+#include "magnetics/near_field.h"
 #include "magnetics/relax.h"
 
 namespace odemag::stability {
@@ -155,6 +156,18 @@ inline double relaxed_free_energy(MagneticForces& magnetics) {
                   cell_free_energy(body.soft, Vec3{}, &state.moments[model.moment_offset(c)]));
       }
     }
+  }
+  // Near-field energy of the fixed magnets alone (their reflection in the
+  // spheres' higher orders; the soft cells' share is in H_fixed and H_soft):
+  // the state with every responsive magnetization zero. Approximate where a
+  // sphere's contact saturates (its saturation factor then differs).
+  {
+    MagneticState fixed_only = state;
+    for (int c = 0; c < model.cell_count(); ++c)
+      if (model.body(model.cell_body(c)).responsive()) fixed_only.magnetization[c] = {};
+    NearField near;
+    near.build(model, fixed_only, magnetics.options().near_field, magnetics.options().mutual_induction);
+    u += near.energy(model, fixed_only);
   }
   for (size_t i = 0; i < fixed.size(); ++i) {
     const int a = fixed[i], ba = model.cell_body(a);

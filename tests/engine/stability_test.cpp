@@ -245,8 +245,14 @@ class StabilityObjectSize : public ::testing::TestWithParam<double> {};
 
 TEST_P(StabilityObjectSize, BallComesToRestOnTheMagnet) {
   const double scale = GetParam();
-  const CaseResult r =
-      run_case("scaled ball onto magnet", scaled_ball_onto_magnet(scale), for_seconds(1.0));
+  SceneDescription scene = scaled_ball_onto_magnet(scale);
+  // 1 mm objects at 4 ms steps want about 400 substeps; with the default cap
+  // of 64 the point-dipole contact happened to stay within the energy bound,
+  // but the near field's contact force (2.4 times stronger at touching,
+  // docs/model.md "The near field") threw the ball off the magnet. So this
+  // size runs with a cap that covers what the rule wants.
+  if (scale < 2e-3) scene.simulation.max_substeps = 1024;
+  const CaseResult r = run_case("scaled ball onto magnet", scene, for_seconds(1.0));
   expect_stable(r, false);
   // Resting on it: centres one sum of radii apart, within the contact
   // softness (ODE's CFM is absolute, so a 0.3 m ball pressed on by 50 kN

@@ -1,0 +1,452 @@
+// Close pairs of one-cell spheres: their induced higher multipoles
+// (magnetics/near_field.h; docs/model.md "The near field").
+//
+// A linear sphere (radius R, mu = 1 + chi) in an applied potential
+//   phi_A = sum_lm I_lm r^l P_l^m(cos theta) e^{i m phi}        (about its centre)
+// answers each order with the exterior potential
+//   phi_ind = sum_lm E_lm r^-(l+1) P_l^m e^{i m phi},   E_lm = -gamma_l R^(2l+1) I_lm,
+//   gamma_l = l (mu - 1) / (l mu + l + 1).
+// The cell's dipole (l = 1) is what the relaxation solves, with saturation;
+// l = 1 of the applied potential is the field at the centre, so the dipole is
+// right. Missing are the orders l >= 2. For a pair of cells a, b (b at
+// distance d along +z from a) with dipoles p_a, p_b these are linear in the
+// dipoles; in the pair's frame they split into the axial sector m = 0 and the
+// transverse sector m = 1 (a dipole's potential has no other m). Exterior
+// harmonics about a become interior ones about b by the addition theorem
+// (Ferrers functions without the Condon-Shortley phase):
+//   r_a^-(l+1) P_l^m = sum_l' (-1)^(l'+m) (l+l')! / ((l-m)! (l'+m)!) r_b^l' P_l'^m / d^(l+l'+1),
+// and from b to a the sign is (-1)^(l+m). With the scaled coefficients
+// e = E / R^(l+1) and i = I R^l (d = 1) the two-centre problem is
+//   e_b[l] = -gamma_b,l sum_k A_ab[k][l] e_a[k],  A_ab = (-1)^(l+m) C(k, l) r_a^(k+1) r_b^l,
+// (likewise e_a), for l = 2..L, with e[1] = p / (4 pi R^2) given. Its
+// solution gives the extra field at each centre, H = -I_1 (the l = 1 interior
+// coefficient of the partner's higher orders), linear in the dipoles:
+//   H_a = K_aa p_a + K_ab p_b,   H_b = K_ab p_a + K_bb p_b,
+//   K_xy = k_par,xy(d) u u^T + k_perp,xy(d) (I - u u^T)   (u = (x_b - x_a) / d),
+// symmetric by reciprocity. Eliminating the higher orders (linear, so exactly)
+// leaves the pair energy W = -mu0/2 sum_xy p_x . K_xy p_y: its derivative in
+// the dipoles is the extra field the relaxation adds to H_A, its gradient in
+// the positions (dipoles fixed; they are stationary) the extra force, and
+// mu0 p x H the extra torque. For a rigid partner (a permanent magnet or any
+// non-spherical cell, which the dense sums treat as a point dipole) gamma = 0
+// and W is the exact energy of a sphere next to a point dipole.
+//
+// The six k(d) d^3, functions of x = d / (R_a + R_b) only for a given pair
+// type (radius ratio, susceptibilities), are tabulated once per pair type on
+// knots clustered at contact and interpolated by natural cubic splines, so
+// forces are the exact derivative of the interpolated energy.
+//
+// Range: full correction up to x = 3 (a gap of 4 R between equal spheres),
+// smoothly tapered to 0 at x = 4; below contact (overlapping cells) each
+// coefficient fades to 0 within 0.1 (R_a + R_b) by a cubic matching its value
+// and slope at contact, so forces stay finite and continuous through contact
+// and deeply overlapping high-chi balls stay stable.
+//
+// Saturation: a saturated sphere is uniformly magnetized, exactly a dipole,
+// and real iron saturates first at the contact point. The table also holds
+// the higher orders' magnetization at each contact point; where it would take
+// the contact point past Ms the pair's correction is scaled down so that it
+// stays at Ms (saturation_factor): the linear value while the contact is
+// unsaturated, nothing once the sphere is. A heuristic between two exact
+// limits (docs/model.md); forces take it as fixed (no gradient of the factor).
+//
+// Pairs, not clusters: the higher orders of a sphere excited by two
+// neighbours are the sum of the two pairs' (linear), but the cross terms
+// between neighbours through a third sphere's higher orders are neglected.
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <tuple>
+#include <variant>
+
+#include "magnetics/constants.h"
+#include "magnetics/near_field.h"
+
+namespace odemag {
+
+namespace {
+
+constexpr int kOrders = 48;             // L, highest multipole order of the two-centre solve
+constexpr double kTaperStart = 3.0;     // x = d / (R_a + R_b) where the taper begins
+constexpr double kCutoff = 4.0;         // x beyond which a pair has no correction
+constexpr double kInsideFade = 0.1;     // overlap (of R_a + R_b) over which K fades to 0
+constexpr int kKnots = 160;             // spline knots on [1, kCutoff]
+
+// gamma_l of a linear sphere; chi = infinity gives 1.
+double multipole_factor(int l, double chi) {
+  if (std::isinf(chi)) return 1.0;
+  return l * chi / (l * chi + 2.0 * l + 1.0);
+}
+
+// The reaction coefficients k d^3 of one pair at one distance:
+// [sector][aa, ab, bb], sector 0 axial, 1 transverse, and the axial
+// magnetization of the higher orders at each sphere's contact point (the
+// point of its surface on the line of centres, facing the partner) per unit
+// axial dipole, times d^3: [a from p_a, a from p_b, b from p_a, b from p_b].
+struct Reaction {
+  std::array<std::array<double, 3>, 2> k{};
+  std::array<double, 4> contact{};
+};
+
+// What the table of a pair type depends on: R_a / (R_a + R_b) and the two
+// susceptibilities (negative: rigid, no higher orders).
+struct PairType {
+  double radius_share;
+  double chi_a, chi_b;
+  bool operator<(const PairType& o) const {
+    return std::tie(radius_share, chi_a, chi_b) < std::tie(o.radius_share, o.chi_a, o.chi_b);
+  }
+};
+
+// The two-centre solve at x = d / (R_a + R_b) (d = 1 units: r_a, r_b < 1).
+Reaction solve_pair(const PairType& type, double x) {
+  const double ra = type.radius_share / x, rb = (1.0 - type.radius_share) / x;
+  const int L = kOrders, n = L - 1;  // unknown orders 2..L per sphere
+  std::vector<double> log_factorial(2 * L + 2);
+  for (int i = 0; i < 2 * L + 2; ++i) log_factorial[i] = std::lgamma(i + 1.0);
+  const double log_ra = std::log(ra), log_rb = std::log(rb);
+  Reaction out{};
+  for (int m = 0; m < 2; ++m) {
+    // A_ab(k, l): e_a[k] -> i_b[l] = (-1)^(l+m) (k+l)! / ((k-m)! (l+m)!) r_a^(k+1) r_b^l;
+    // A_ba(k, l) likewise with the radii swapped and the sign (-1)^(k+m).
+    Eigen::MatrixXd A_ab_table(L + 1, L + 1), A_ba_table(L + 1, L + 1);
+    for (int k = 1; k <= L; ++k)
+      for (int l = 1; l <= L; ++l) {
+        const double c = log_factorial[k + l] - log_factorial[k - m] - log_factorial[l + m];
+        A_ab_table(k, l) = ((l + m) % 2 ? -1.0 : 1.0) * std::exp(c + (k + 1) * log_ra + l * log_rb);
+        A_ba_table(k, l) = ((k + m) % 2 ? -1.0 : 1.0) * std::exp(c + (k + 1) * log_rb + l * log_ra);
+      }
+    auto A_ab = [&](int k, int l) { return A_ab_table(k, l); };
+    auto A_ba = [&](int k, int l) { return A_ba_table(k, l); };
+    std::vector<double> ga(L + 1, 0.0), gb(L + 1, 0.0);
+    for (int l = 2; l <= L; ++l) {
+      ga[l] = type.chi_a < 0 ? 0.0 : multipole_factor(l, type.chi_a);
+      gb[l] = type.chi_b < 0 ? 0.0 : multipole_factor(l, type.chi_b);
+    }
+    // Unknowns [e_a[2..L], e_b[2..L]]; rows: e + gamma sum A e_partner = -gamma A e_partner[1].
+    Eigen::MatrixXd S = Eigen::MatrixXd::Identity(2 * n, 2 * n);
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(2 * n, 2);  // columns: p_a = 1, p_b = 1
+    const double ea1 = 1.0 / (4.0 * kPi * ra * ra), eb1 = 1.0 / (4.0 * kPi * rb * rb);
+    for (int l = 2; l <= L; ++l) {
+      for (int k = 2; k <= L; ++k) {
+        S(n + l - 2, k - 2) += gb[l] * A_ab(k, l);
+        S(l - 2, n + k - 2) += ga[l] * A_ba(k, l);
+      }
+      rhs(n + l - 2, 0) = -gb[l] * A_ab(1, l) * ea1;
+      rhs(l - 2, 1) = -ga[l] * A_ba(1, l) * eb1;
+    }
+    const Eigen::MatrixXd e = S.partialPivLu().solve(rhs);
+    if (m == 0) {
+      // Inside a linear sphere c_l = I_l (1 - gamma_l); on the axis at the
+      // contact point z = +-R, H_z = -sum_l l c_l (+-R)^(l-1), M = chi H.
+      // chi (1 - gamma_l) = chi (2l + 1) / (l chi + 2l + 1), finite for chi = inf.
+      auto chi_rest = [](int l, double chi) {
+        if (chi < 0) return 0.0;
+        return std::isinf(chi) ? (2.0 * l + 1.0) / l : chi * (2.0 * l + 1.0) / (l * chi + 2.0 * l + 1.0);
+      };
+      for (int col = 0; col < 2; ++col) {
+        // Scaled interior coefficients i[l] at each centre from the partner's
+        // dipole and higher orders (i = I R^l, d = 1).
+        double Ma = 0.0, Mb = 0.0;
+        for (int l = 2; l <= L; ++l) {
+          double ia = A_ba(1, l) * (col == 1 ? eb1 : 0.0), ib = A_ab(1, l) * (col == 0 ? ea1 : 0.0);
+          for (int k = 2; k <= L; ++k) ia += A_ba(k, l) * e(n + k - 2, col), ib += A_ab(k, l) * e(k - 2, col);
+          // a's contact point at z = +R_a, b's at z = -R_b (sign (-1)^(l-1)).
+          Ma -= chi_rest(l, type.chi_a) * l * ia / ra;
+          Mb -= chi_rest(l, type.chi_b) * l * ib * ((l - 1) % 2 ? -1.0 : 1.0) / rb;
+        }
+        out.contact[col] = Ma;
+        out.contact[2 + col] = Mb;
+      }
+    }
+    // H at b from a's higher orders: -i_b[1] / r_b; at a from b's: -i_a[1] / r_a.
+    for (int col = 0; col < 2; ++col) {
+      double Hb = 0.0, Ha = 0.0;
+      for (int k = 2; k <= L; ++k) {
+        Hb -= A_ab(k, 1) * e(k - 2, col) / rb;
+        Ha -= A_ba(k, 1) * e(n + k - 2, col) / ra;
+      }
+      if (col == 0) {
+        out.k[m][0] = Ha;  // aa
+        out.k[m][1] = Hb;  // ab (= ba)
+      } else {
+        out.k[m][2] = Hb;  // bb
+      }
+    }
+  }
+  return out;
+}
+
+// Natural cubic spline through (x_i, y_i) on a non-uniform grid.
+struct Spline {
+  std::vector<double> x, y, y2;
+  void fit() {
+    const int n = static_cast<int>(x.size());
+    y2.assign(n, 0.0);
+    std::vector<double> u(n, 0.0);
+    for (int i = 1; i < n - 1; ++i) {
+      const double sig = (x[i] - x[i - 1]) / (x[i + 1] - x[i - 1]);
+      const double p = sig * y2[i - 1] + 2.0;
+      y2[i] = (sig - 1.0) / p;
+      const double slope = (y[i + 1] - y[i]) / (x[i + 1] - x[i]) - (y[i] - y[i - 1]) / (x[i] - x[i - 1]);
+      u[i] = (6.0 * slope / (x[i + 1] - x[i - 1]) - sig * u[i - 1]) / p;
+    }
+    for (int i = n - 2; i >= 0; --i) y2[i] = y2[i] * y2[i + 1] + u[i];
+  }
+  // Value and derivative at t in [x.front(), x.back()].
+  void eval(double t, double& value, double& slope) const {
+    const int i = std::clamp(static_cast<int>(std::upper_bound(x.begin(), x.end(), t) - x.begin()) - 1, 0,
+                             static_cast<int>(x.size()) - 2);
+    const double h = x[i + 1] - x[i], a = (x[i + 1] - t) / h, b = (t - x[i]) / h;
+    value = a * y[i] + b * y[i + 1] + ((a * a * a - a) * y2[i] + (b * b * b - b) * y2[i + 1]) * h * h / 6.0;
+    slope = (y[i + 1] - y[i]) / h + (-(3 * a * a - 1) * y2[i] + (3 * b * b - 1) * y2[i + 1]) * h / 6.0;
+  }
+};
+
+class PairTable {
+ public:
+  explicit PairTable(const PairType& type) {
+    for (auto& s : splines_) s.x.resize(kKnots), s.y.resize(kKnots);
+    for (auto& s : contact_) s.x.resize(kKnots), s.y.resize(kKnots);
+    for (int i = 0; i < kKnots; ++i) {
+      const double t = static_cast<double>(i) / (kKnots - 1);
+      const double x = 1.0 + (kCutoff - 1.0) * t * t;  // clustered at contact
+      const Reaction r = solve_pair(type, x);
+      for (int s = 0; s < 6; ++s) {
+        splines_[s].x[i] = x;
+        splines_[s].y[i] = r.k[s / 3][s % 3];
+      }
+      for (int s = 0; s < 4; ++s) {
+        contact_[s].x[i] = x;
+        contact_[s].y[i] = r.contact[s];
+      }
+    }
+    for (auto& s : splines_) s.fit();
+    for (auto& s : contact_) s.fit();
+  }
+
+  // Contact-point magnetization coefficients (1/m^3) at centre distance d:
+  // M_hi along u at a = c[0] (u.p_a) + c[1] (u.p_b), at b = c[2] (u.p_a) + c[3] (u.p_b).
+  void contact(double d, double reach, double c[4]) const {
+    const double x = std::clamp(d / reach, 1.0, kCutoff), d3 = std::pow(x * reach, 3);
+    for (int s = 0; s < 4; ++s) {
+      double v, slope;
+      contact_[s].eval(x, v, slope);
+      c[s] = v / d3;
+    }
+  }
+  // K (1/m^3) and dK/dd (1/m^4) at centre distance d of a pair with
+  // reach = R_a + R_b: k d^3 from the splines with the taper; zero beyond
+  // the cutoff and deep inside contact.
+  void eval(double d, double reach, double K[6], double dK[6]) const {
+    const double x = d / reach;
+    if (x >= kCutoff) {
+      std::fill(K, K + 6, 0.0), std::fill(dK, dK + 6, 0.0);
+      return;
+    }
+    if (x < 1.0) {
+      // Overlapping cells: each K fades to 0 by a cubic Hermite that matches
+      // K and dK/dd at contact (forces continuous) over kInsideFade reach:
+      // bounded, with a repulsive core, and nothing for deeper overlaps (a
+      // constant continuation made overlapping chi = 100 balls unstable).
+      double K1[6], dK1[6];
+      eval(reach, reach, K1, dK1);
+      const double h = kInsideFade * reach, t = (d - (reach - h)) / h;
+      for (int s = 0; s < 6; ++s) {
+        if (t <= 0.0) {
+          K[s] = dK[s] = 0.0;
+          continue;
+        }
+        K[s] = K1[s] * t * t * (3.0 - 2.0 * t) + dK1[s] * h * t * t * (t - 1.0);
+        dK[s] = (K1[s] * 6.0 * t * (1.0 - t)) / h + dK1[s] * t * (3.0 * t - 2.0);
+      }
+      return;
+    }
+    // Taper w(x): 1 below kTaperStart, 0 at kCutoff, C^2 (smootherstep).
+    double w = 1.0, dw = 0.0;
+    if (x > kTaperStart) {
+      const double u = (x - kTaperStart) / (kCutoff - kTaperStart);
+      w = 1.0 - u * u * u * (10.0 - 15.0 * u + 6.0 * u * u);
+      dw = -30.0 * u * u * (1.0 - u) * (1.0 - u) / (kCutoff - kTaperStart);
+    }
+    const double d3 = d * d * d;
+    for (int s = 0; s < 6; ++s) {
+      double k, dk;
+      splines_[s].eval(x, k, dk);
+      // K = w k / d^3, d/dd = (w dk/dx + dw/dx k) / (reach d^3) - 3 w k / d^4.
+      K[s] = w * k / d3;
+      dK[s] = (w * dk + dw * k) / (reach * d3) - 3.0 * K[s] / d;
+    }
+  }
+
+ private:
+  std::array<Spline, 6> splines_;
+  std::array<Spline, 4> contact_;
+};
+
+// One table per pair type, shared by every model of the process.
+std::shared_ptr<const PairTable> pair_table(const PairType& type) {
+  static std::mutex mutex;
+  static std::map<PairType, std::shared_ptr<const PairTable>> tables;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& t = tables[type];
+  if (!t) t = std::make_shared<const PairTable>(type);
+  return t;
+}
+
+// How a one-cell body takes part: radius and susceptibility of its higher
+// orders (negative: rigid).
+struct SphereCell {
+  int cell = -1;
+  double radius = 0.0;
+  double chi = -1.0;
+  bool multipoles() const { return chi >= 0.0; }
+};
+
+struct SpherePair {
+  int a = -1, b = -1;                // cells
+  int body_a = -1, body_b = -1;
+  Vec3 u;                            // (x_b - x_a) / d
+  double d = 0.0;
+  double k[6] = {};                  // K entries, 1/m^3: [par aa, ab, bb, perp aa, ab, bb]
+  double dk[6] = {};                 // dK/dd, 1/m^4
+  double contact[4] = {};            // PairTable::contact
+};
+
+class SphereNearField final : public NearFieldTerm {
+ public:
+  void build(const MagneticModel& model, const MagneticState& state) override {
+    pairs_.clear();
+    cells_.clear();
+    for (int bi = 0; bi < model.body_count(); ++bi) {
+      const MagneticBody& body = model.body(bi);
+      if (body.inert() || !state.active[bi] || body.cell_count() != 1 || body.cells.spacing > 0.0) continue;
+      SphereCell s;
+      s.cell = body.first_cell;
+      s.radius = body.cells.contact_radius;
+      if (std::holds_alternative<Sphere>(body.shape)) {
+        if (body.kind == CellKind::soft) s.chi = std::get<SoftMaterial>(body.material).susceptibility;
+        if (body.kind == CellKind::recoil_permanent) s.chi = body.recoil;
+      }
+      cells_.push_back(s);
+    }
+    const int n = static_cast<int>(cells_.size());
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) {
+        const SphereCell &ca = cells_[i], &cb = cells_[j];
+        if (!ca.multipoles() && !cb.multipoles()) continue;
+        // Without mutual induction only fixed magnets induce (one partner fixed).
+        if (!mutual_induction_ && model.body(model.cell_body(ca.cell)).responsive() &&
+            model.body(model.cell_body(cb.cell)).responsive())
+          continue;
+        const double reach = ca.radius + cb.radius;
+        const Vec3 r = state.cell_position[cb.cell] - state.cell_position[ca.cell];
+        const double d2 = dot(r, r);
+        if (d2 >= kCutoff * kCutoff * reach * reach) continue;
+        SpherePair p;
+        p.a = ca.cell, p.b = cb.cell;
+        p.body_a = model.cell_body(p.a), p.body_b = model.cell_body(p.b);
+        p.d = std::sqrt(d2);
+        // Coincident centres: any axis (the functions are constant there).
+        p.u = p.d > 0.0 ? r / p.d : Vec3{0.0, 0.0, 1.0};
+        const auto table = pair_table({ca.radius / reach, ca.chi, cb.chi});
+        table->eval(p.d, reach, p.k, p.dk);
+        table->contact(p.d, reach, p.contact);
+        pairs_.push_back(p);
+      }
+  }
+
+  void add_field(const MagneticModel& model, const MagneticState& state, NearFieldSources sources,
+                 std::vector<Vec3>& H) const override {
+    for (const SpherePair& p : pairs_) {
+      const double sigma = saturation_factor(model, state, p);
+      const Vec3 pa = dipole(model, state, p.a), pb = dipole(model, state, p.b);
+      const bool use_a = source_matches(model, p.body_a, sources), use_b = source_matches(model, p.body_b, sources);
+      const Vec3 za = use_a ? pa : Vec3{}, zb = use_b ? pb : Vec3{};
+      if (model.body(p.body_a).responsive())
+        H[p.a] += sigma * (apply(p, 0, za) + apply(p, 1, zb));
+      if (model.body(p.body_b).responsive())
+        H[p.b] += sigma * (apply(p, 1, za) + apply(p, 2, zb));
+    }
+  }
+
+  void add_forces(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& force,
+                  std::vector<Vec3>& field) const override {
+    for (const SpherePair& p : pairs_) {
+      const double sigma = saturation_factor(model, state, p);
+      const Vec3 pa = dipole(model, state, p.a), pb = dipole(model, state, p.b);
+      // F_b = +mu0/2 sigma grad_r (sum_xy p_x . K_xy p_y), F_a = -F_b.
+      const Vec3 g = gradient(p, 0, pa, pa) + 2.0 * gradient(p, 1, pa, pb) + gradient(p, 2, pb, pb);
+      const Vec3 Fb = 0.5 * kMu0 * sigma * g;
+      force[p.b] += Fb;
+      force[p.a] -= Fb;
+      field[p.a] += sigma * (apply(p, 0, pa) + apply(p, 1, pb));
+      field[p.b] += sigma * (apply(p, 1, pa) + apply(p, 2, pb));
+    }
+  }
+
+  double energy(const MagneticModel& model, const MagneticState& state) const override {
+    double e = 0.0;
+    for (const SpherePair& p : pairs_) {
+      const double sigma = saturation_factor(model, state, p);
+      const Vec3 pa = dipole(model, state, p.a), pb = dipole(model, state, p.b);
+      e -= 0.5 * kMu0 * sigma *
+           (dot(pa, apply(p, 0, pa)) + 2.0 * dot(pa, apply(p, 1, pb)) + dot(pb, apply(p, 2, pb)));
+    }
+    return e;
+  }
+
+  int pair_count() const override { return static_cast<int>(pairs_.size()); }
+
+ private:
+  static Vec3 dipole(const MagneticModel& model, const MagneticState& state, int c) {
+    return model.body(model.cell_body(c)).cells.cell_volume * state.magnetization[c];
+  }
+  static bool source_matches(const MagneticModel& model, int body, NearFieldSources sources) {
+    return model.body(body).responsive() == (sources == NearFieldSources::responsive);
+  }
+  // K_xy p for block xy = 0 (aa), 1 (ab), 2 (bb).
+  static Vec3 apply(const SpherePair& p, int xy, const Vec3& v) {
+    const double par = p.k[xy], perp = p.k[3 + xy];
+    return perp * v + ((par - perp) * dot(p.u, v)) * p.u;
+  }
+  // grad_r of s . K_xy(r) t, r = x_b - x_a.
+  static Vec3 gradient(const SpherePair& p, int xy, const Vec3& s, const Vec3& t) {
+    const double dpar = p.dk[xy], dperp = p.dk[3 + xy], delta = p.k[xy] - p.k[3 + xy];
+    const double us = dot(p.u, s), ut = dot(p.u, t);
+    Vec3 g = (dperp * dot(s, t) + (dpar - dperp) * us * ut) * p.u;
+    if (p.d > 0.0) g += (delta / p.d) * ((s - us * p.u) * ut + us * (t - ut * p.u));
+    return g;
+  }
+  // Local saturation at the contact points: the linear higher orders would
+  // add M_hi (along u) to a soft sphere's magnetization M at its contact
+  // point; where |M| + |M_hi| would pass Ms they are scaled by
+  // sigma = (Ms - |M|) / |M_hi|, the smallest over the pair's soft spheres.
+  double saturation_factor(const MagneticModel& model, const MagneticState& state, const SpherePair& p) const {
+    const Vec3 pa = dipole(model, state, p.a), pb = dipole(model, state, p.b);
+    const double ua = dot(p.u, pa), ub = dot(p.u, pb);
+    double sigma = 1.0;
+    for (int side = 0; side < 2; ++side) {
+      const int c = side == 0 ? p.a : p.b;
+      const MagneticBody& body = model.body(model.cell_body(c));
+      if (body.kind != CellKind::soft || !std::holds_alternative<Sphere>(body.shape)) continue;
+      const double M_hi = std::fabs(p.contact[2 * side] * ua + p.contact[2 * side + 1] * ub);
+      const double room = std::max(0.0, body.soft.Ms - norm(state.magnetization[c]));
+      if (M_hi > room) sigma = std::min(sigma, room / M_hi);
+    }
+    return sigma;
+  }
+
+  std::vector<SphereCell> cells_;
+  std::vector<SpherePair> pairs_;
+};
+
+}  // namespace
+
+std::unique_ptr<NearFieldTerm> make_sphere_near_field() { return std::make_unique<SphereNearField>(); }
+
+}  // namespace odemag
