@@ -16,7 +16,8 @@
 #include <limits>
 #include <vector>
 
-#include "contact_references.h"
+#include "tests/magnetics/contact_references.h"
+#include "tests/magnetics/reference_fields.h"
 
 namespace odemag {
 namespace {
@@ -412,25 +413,7 @@ TEST(CubeDemag, RectangleFieldMatchesQuadrature) {
   const double u1 = -0.2, u2 = 0.3, v1 = 0.1, v2 = 0.25;
   std::vector<double> gx, gw;
   const int n = 40;
-  gx.resize(n);
-  gw.resize(n);
-  for (int i = 0; i < n; ++i) {  // Newton on P_n
-    double t = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 1.0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1.0, p1 = t;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * t * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (t * p1 - p0) / (t * t - 1.0);
-      const double dt = p1 / dp;
-      t -= dt;
-      if (std::abs(dt) < 1e-16) break;
-    }
-    gx[i] = t;
-    gw[i] = 2.0 / ((1.0 - t * t) * dp * dp);
-  }
+  reference::gauss_legendre(n, gx, gw);
   for (const Vec3& r : {Vec3{0.05, 0.2, 0.3}, Vec3{-0.6, 0.4, -0.25}, Vec3{0.9, -0.3, 0.1}}) {
     Vec3 H;  // (u, v, w) components
     for (int i = 0; i < n; ++i)
