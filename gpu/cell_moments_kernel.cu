@@ -12,7 +12,7 @@ __global__ void __launch_bounds__(kThreadsPerBlock) cell_moments_kernel(CellMome
   const int i = blockIdx.x * kThreadsPerBlock + threadIdx.x;
   if (i >= a.cells) return;
   const DeviceBody& body = a.bodies[a.body[i]];
-  const Vec3 mu = body.cell_volume * a.magnetization[i];
+  const Vec3 mu = a.volume[i] * a.magnetization[i];
   a.mu[i] = mu;
   if (a.mu_body) a.mu_body[i] = body.rotation.transpose_times(mu);
 }

@@ -34,6 +34,7 @@
 #include "gpu/device_data.cuh"
 #include "magnetics/field_probe.h"
 #include "magnetics/near_field.h"
+#include "magnetics/state.h"
 
 namespace odemag {
 
@@ -170,7 +171,6 @@ class CudaBackend final : public MagneticBackend {
       d.soft = body.soft;
       d.remanent = d.rotation * (state.magnetization_scale[b] * body.remanence);
       d.recoil = body.recoil;
-      d.cell_volume = body.cells.cell_volume;
       d.table = table_offset_[b];
       const auto& n = body.cells.lattice_extent;
       d.key_centre = gpu::lattice_key(n[0] - 1, n[1] - 1, n[2] - 1, body.offset_extent[0],
@@ -184,6 +184,7 @@ class CudaBackend final : public MagneticBackend {
     resp_soft_.clear(), all_positions_.clear(), moment_runs_.clear();
     h_resp_point_.clear(), h_fixed_point_.clear(), h_all_point_.clear();
     h_resp_body_.clear(), h_resp_key_.clear(), h_resp_moment_.clear();
+    h_resp_volume_.clear(), h_all_volume_.clear();
     h_fixed_mu_.clear(), h_history_.clear(), h_counter_.clear();
     moment_total_ = 0;
     for (int b = 0; b < model.body_count(); ++b) {
@@ -202,18 +203,21 @@ class CudaBackend final : public MagneticBackend {
       for (int i = 0; i < body.cell_count(); ++i) {
         const int c = body.first_cell + i;
         const Vec3& x = state.cell_position[c];
-        const CellPoint point{x.x, x.y, x.z, body.cells.contact_radius};
+        const CellPoint point{x.x, x.y, x.z, body.cells.contact_radii[i]};
+        const double volume = body.cells.volumes[i];
         all_cells_.push_back(c);
         all_bodies_.push_back(b);
         all_positions_.push_back(x);
         h_all_point_.push_back(point);
+        h_all_volume_.push_back(volume);
         if (!body.responsive()) {
           fixed_cells_.push_back(c);
           h_fixed_point_.push_back(point);
-          h_fixed_mu_.push_back(body.cells.cell_volume * state.magnetization[c]);
+          h_fixed_mu_.push_back(volume * state.magnetization[c]);
           continue;
         }
         resp_cells_.push_back(c);
+        h_resp_volume_.push_back(volume);
         resp_soft_.push_back(soft ? 1 : 0);
         h_resp_point_.push_back(point);
         h_resp_body_.push_back(b);
@@ -250,6 +254,8 @@ class CudaBackend final : public MagneticBackend {
     resp_key_.upload(h_resp_key_.data(), h_resp_key_.size(), s);
     resp_cell_.upload(resp_cells_.data(), resp_cells_.size(), s);
     resp_moment_.upload(h_resp_moment_.data(), h_resp_moment_.size(), s);
+    resp_volume_.upload(h_resp_volume_.data(), h_resp_volume_.size(), s);
+    all_volume_.upload(h_all_volume_.data(), h_all_volume_.size(), s);
     history_.upload(h_history_.data(), h_history_.size(), s);
     counter_.upload(h_counter_.data(), h_counter_.size(), s);
     fixed_point_.upload(h_fixed_point_.data(), h_fixed_point_.size(), s);
@@ -259,7 +265,8 @@ class CudaBackend final : public MagneticBackend {
     moments_.upload(h_moments_.data(), h_moments_.size(), s);
     hc_prev_.upload(h_hc_prev_.data(), h_hc_prev_.size(), s);
     up += bodies_.bytes() + resp_point_.bytes() + resp_body_.bytes() + resp_key_.bytes() +
-          resp_cell_.bytes() + resp_moment_.bytes() + history_.bytes() + counter_.bytes() +
+          resp_cell_.bytes() + resp_moment_.bytes() + resp_volume_.bytes() + all_volume_.bytes() +
+          history_.bytes() + counter_.bytes() +
           fixed_point_.bytes() + fixed_mu_.bytes() + all_point_.bytes() + all_body_.bytes() +
           moments_.bytes() + hc_prev_.bytes();
     timer.uploads_done();
@@ -309,8 +316,9 @@ class CudaBackend final : public MagneticBackend {
     resp_mu_.resize(n);
     resp_mu_body_.resize(n);
     resp_H_.resize(n);
-    gpu::launch_cell_moments(
-        {n, resp_body_.data(), bodies_.data(), resp_M_.data(), resp_mu_.data(), resp_mu_body_.data()}, s);
+    gpu::launch_cell_moments({n, resp_body_.data(), bodies_.data(), resp_volume_.data(), resp_M_.data(),
+                              resp_mu_.data(), resp_mu_body_.data()},
+                             s);
     gpu::launch_responsive_field({n, resp_point_.data(), resp_body_.data(), resp_key_.data(),
                                   resp_mu_.data(), resp_mu_body_.data(), bodies_.data(),
                                   tables_.data(), resp_H_.data()},
@@ -320,6 +328,7 @@ class CudaBackend final : public MagneticBackend {
     resp_H_.download(pin_out_.data(), n, s);
     timer.synchronize(bytes_of<Vec3>(n), bytes_of<Vec3>(n));
     for (int i = 0; i < n; ++i) H[resp_cells_[i]] = pin_out_[i];
+    add_boundary_field(model, state, H);
     near_.add_field(model, state, NearFieldSources::responsive, H);
     timer.stop();
   }
@@ -393,7 +402,8 @@ class CudaBackend final : public MagneticBackend {
     all_mu_.resize(n);
     all_force_.resize(n);
     all_field_.resize(n);
-    gpu::launch_cell_moments({n, all_body_.data(), bodies_.data(), all_M_.data(), all_mu_.data(), nullptr}, s);
+    gpu::launch_cell_moments(
+        {n, all_body_.data(), bodies_.data(), all_volume_.data(), all_M_.data(), all_mu_.data(), nullptr}, s);
     gpu::launch_cell_forces(
         {n, all_point_.data(), all_body_.data(), all_mu_.data(), all_force_.data(), all_field_.data()}, s);
     timer.kernels_done();
@@ -415,7 +425,7 @@ class CudaBackend final : public MagneticBackend {
     for (int i = 0; i < n; ++i) {
       const int b = all_bodies_[i];
       const Vec3& xi = all_positions_[i];
-      const Vec3 mi = model.body(b).cells.cell_volume * state.magnetization[all_cells_[i]];
+      const Vec3 mi = h_all_volume_[i] * state.magnetization[all_cells_[i]];
       const Vec3& f = pin_out_[i];
       state.force[b] += f;
       state.torque[b] += cell_torque(xi - state.pose[b].position, f, mi, pin_out2_[i] + state.external_field);
@@ -498,13 +508,14 @@ class CudaBackend final : public MagneticBackend {
   std::vector<DeviceBody> h_bodies_;
   std::vector<CellPoint> h_resp_point_, h_fixed_point_, h_all_point_;
   std::vector<int> h_resp_body_, h_resp_key_, h_resp_moment_;
+  std::vector<double> h_resp_volume_, h_all_volume_;  // V of each cell (CellSet::volumes)
   std::vector<Vec3> h_fixed_mu_, h_moments_, h_hc_prev_;
   std::vector<uint8_t> h_history_;
   std::vector<uint64_t> h_counter_;
 
   // Device data.
   DeviceBuffer<DeviceBody> bodies_;
-  DeviceBuffer<double> tables_;
+  DeviceBuffer<double> tables_, resp_volume_, all_volume_;
   DeviceBuffer<CellPoint> resp_point_, fixed_point_, all_point_;
   DeviceBuffer<int> resp_body_, resp_key_, resp_cell_, resp_moment_, all_body_;
   DeviceBuffer<Vec3> fixed_mu_, resp_M_, resp_mu_, resp_mu_body_, resp_H_, resp_applied_;

@@ -41,7 +41,6 @@ struct DeviceBody {
   SoftCellParams soft;   // soft bodies: material of every cell (body frame)
   Vec3 remanent;         // recoil magnets: R (scale M_r), world
   double recoil;         // recoil magnets: chi_r
-  double cell_volume;    // V of each cell, m^3
   long long table;       // first double of the body's offset tensors in the table array, -1: none
   int key_centre;        // table entry (in tensors) of offset zero: key(a) - key(b) + key_centre
   int cell_count;
@@ -55,11 +54,13 @@ inline int lattice_key(int i, int j, int k, int extent_x, int extent_y) {
   return i + extent_x * (j + extent_y * k);
 }
 
-// mu = V M (world) and, when mu_body is not null, R^T mu (body frame).
+// mu = V M (world) and, when mu_body is not null, R^T mu (body frame); V the
+// cell's own volume (CellSet::volumes).
 struct CellMomentsArgs {
   int cells;
   const int* body;
   const DeviceBody* bodies;
+  const double* volume;
   const Vec3* magnetization;
   Vec3* mu;
   Vec3* mu_body;  // may be null
@@ -80,7 +81,7 @@ void launch_fixed_field(const FixedFieldArgs& a, cudaStream_t stream);
 
 // Field of the responsive cells at each responsive cell: other bodies through
 // the dipole kernel, the own body through the cached offset tensors
-// (responsive_field).
+// (responsive_field; the host adds the boundary correction, add_boundary_field).
 struct ResponsiveFieldArgs {
   int cells;
   const CellPoint* point;

@@ -4,7 +4,8 @@
 // contact distance target radius + source radius; a source of the target's own
 // body through the body's cached offset tensor (body frame), summed apart and
 // rotated to the world once, exactly as the CPU backend does. Every target
-// sums its sources in cell order (deterministic).
+// sums its sources in cell order (deterministic). The boundary correction of
+// bodies with partial cells is added on the host (add_boundary_field).
 #include "gpu/cuda_check.cuh"
 #include "gpu/device_data.cuh"
 #include "magnetics/kernels.h"

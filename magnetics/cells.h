@@ -1,4 +1,4 @@
-// Per-body cell sets on a cubic lattice (MODEL.md "Cells").
+// Per-body cell sets on a cubic lattice (docs/model.md "Cells").
 #pragma once
 
 #include <array>
@@ -9,33 +9,75 @@
 
 namespace odemag {
 
-// The cells of one body, in the body frame. Every cell stands for the same
-// volume: the body's volume divided by the cell count, so that the body's
-// total moment is M times its volume exactly (h^3 for boxes whose edges are
-// multiples of h; (4/3) pi R^3 for a single-cell ball).
+// The cells of one body, in the body frame (make_cells). A volume-share
+// cell stands for the part of its cube (edge h, centred on its lattice site)
+// inside the body: its volume is that part's volume (h^3 for a whole cube)
+// and its position that part's centroid (the site for a whole cube). A
+// centre-inside cell sits at its site and stands for volume / N. Either way
+// the body's total moment is M times its volume. A one-cell body stands for
+// the whole body.
 struct CellSet {
-  std::vector<Vec3> local_positions;            // body frame, m
+  std::vector<Vec3> local_positions;              // body frame, m: centroid of the cell's part of the body
   std::vector<std::array<int, 3>> lattice_index;  // integer lattice coordinates, 0-based
-  std::array<int, 3> lattice_extent{1, 1, 1};   // lattice points per axis of the bounding lattice
-  double spacing = 0.0;                         // h, m; 0 for a single cell
-  double cell_volume = 0.0;                     // V, m^3
-  double cell_radius = 0.0;                     // radius of the sphere of volume V, m
-  // Radius of the sphere inscribed in the solid a cell stands for: h/2 for a
-  // lattice cell (centre to the face of its cube), R for a one-cell ball, the
-  // smallest half extent for another one-cell body. Two cells of different
-  // bodies interact through the exact dipole kernel while their centres are
-  // farther apart than the sum of their contact radii, so bodies that touch
-  // never reach the bounded core (magnetics/kernels.h).
+  std::vector<double> volumes;                    // V_i, m^3: volume of the cell's part of the body
+  // Per cell: the radius of the sphere about the cell point inscribed in the
+  // cell's part of the body (h/2 for a whole cube), floored at h/4 (see
+  // contact_radius below).
+  std::vector<double> contact_radii;
+  std::array<int, 3> lattice_extent{1, 1, 1};     // lattice points per axis of the bounding lattice
+  double spacing = 0.0;                           // h, m; 0 for a single cell
+  // The volume the intra-body tensors divide by (T = -N / cell_volume,
+  // magnetics/model.cpp): h^3 for volume-share cells, volume / N for
+  // centre-inside cells, the body's volume for a one-cell body.
+  double cell_volume = 0.0;
+  double cell_radius = 0.0;                       // radius of the sphere of volume cell_volume, m
+  // Radius of the sphere inscribed in the solid a whole cell stands for: h/2
+  // for a lattice cell (centre to the face of its cube), R for a one-cell
+  // ball, the smallest half extent for another one-cell body; the largest of
+  // contact_radii. Two cells of different bodies interact through the exact
+  // dipole kernel while their points are farther apart than the sum of their
+  // contact radii, so bodies that touch never reach the bounded core
+  // (magnetics/kernels.h); a boundary cell, whose point lies closer to the
+  // surface, has the smaller radius of its own part (not below h/4).
   double contact_radius = 0.0;
+  // True when every cell stands for cell_volume (centre-inside cells, and
+  // volume-share cells that are all whole cubes); false when some are partial
+  // cubes: the body then gets the boundary correction (MagneticBody::
+  // self_tensors).
+  bool whole_cells = true;
 
   int size() const { return static_cast<int>(local_positions.size()); }
 };
 
-// Cells of a shape on a lattice of spacing h = cell_size. With cell_size <= 0
-// (or a lattice coarser than the shape) the body is one cell at its centre.
-// Per axis the lattice has max(1, floor(extent / h)) points spaced h apart and
-// centred on the body, so no cell's cube reaches beyond the body; points
-// inside the shape become cells.
+// Cells of a shape on a lattice of spacing h = cell_size (docs/model.md
+// "Cells"). With cell_size <= 0 the body is one cell at its centre, standing
+// for the whole body. Curved bodies (balls, cylinders) at least
+// kMinVolumeShareExtent h across along every axis get volume-share cells: per
+// axis ceil(extent / h) points spaced h apart and centred on the body (so the
+// cubes cover it), and every cube with a share of its volume inside the shape
+// above kMinCellShare is a cell, standing for that part at its centroid.
+// Boxes, and bodies thinner than that, keep centre-inside cells: per axis
+// max(1, floor(extent / h)) points, those inside the shape are cells standing
+// for volume / N each (h^3 for boxes whose edges are multiples of h); a
+// lattice coarser than the body gives one cell at the centre.
 CellSet make_cells(const Shape& shape, double cell_size);
+
+// True when make_cells gives the shape volume-share cells.
+bool uses_volume_shares(const Shape& shape, double cell_size);
+
+// Cubes with less than this share of their volume inside the shape are left
+// out (their volume, at most this share of h^3 each, is lost).
+inline constexpr double kMinCellShare = 1e-9;
+// Extent (in cells, every axis) from which a curved body has volume-share cells.
+inline constexpr double kMinVolumeShareExtent = 2.0;
+
+// The demagnetising tensor of the uniformly magnetized shape, averaged over
+// cell i's part of it: H = -N M there for a body of uniform magnetization M
+// (body frame, six components xx, xy, xz, yy, yz, zz; trace 1). Exactly I/3
+// for a ball; for a box the closed-form cuboid tensor averaged over the cell's
+// box by 3x3x3 Gauss points; for a cylinder the field of its charged end
+// discs and side (one-dimensional quadratures) at 3 Gauss points along the
+// axis through the centroid of the cell's cross-section.
+void uniform_demag_over_cell(const Shape& shape, const CellSet& cells, int i, double n[6]);
 
 }  // namespace odemag

@@ -202,6 +202,7 @@ class CpuBackend final : public MagneticBackend {
       }
       H[resp_.cell[i]] = h;
     }
+    add_boundary_field(model, state, H);
     near_.add_field(model, state, NearFieldSources::responsive, H);
   }
 

@@ -16,7 +16,8 @@ std::vector<ProbeCell> probe_cells(const MagneticModel& model, const MagneticSta
     const double reach = kProbeNearBodies * norm(shape_half_extents(body.shape));
     base.near2 = reach * reach;
     const double h = body.cells.spacing;
-    if (h > 0.0) {  // lattice cell: a cube of edge h carrying the cell's moment
+    if (h > 0.0) {  // lattice cell: a cube of edge h carrying the cell's moment (a boundary
+                    // cell, V < h^3: the cube at its point with the reduced magnetization mu / h^3)
       base.kind = ProbeCell::cuboid;
       base.half = {0.5 * h, 0.5 * h, 0.5 * h};
       base.volume = h * h * h;
@@ -34,7 +35,7 @@ std::vector<ProbeCell> probe_cells(const MagneticModel& model, const MagneticSta
       const int c = body.first_cell + i;
       ProbeCell cell = base;
       cell.position = state.cell_position[c];
-      cell.moment = body.cells.cell_volume * state.magnetization[c];
+      cell.moment = body.cells.volumes[i] * state.magnetization[c];
       cells.push_back(cell);
     }
   }

@@ -17,8 +17,9 @@
 //   K = w_a(c) w_r(|d|) [ (T_A(d) + T_B(d)) / 2 - T(r; s_ij) ],
 //   T_X(d) = -R_X N_s(R_X^T d) R_X^T / V,   V = sqrt(V_i V_j) (pair_volume),
 //
-// d = site_i - site_j and r = x_i - x_j (the same today: cell points are the
-// lattice sites; kept apart for cells whose point is off their site), T(r; s_ij) the dense kernel
+// d = site_i - site_j and r = x_i - x_j (the same today: the cube of a
+// boundary cell is centred on its point, the centroid of its part, which puts
+// an end face's charge where the material is; coaxial cylinders, docs/model.md), T(r; s_ij) the dense kernel
 // with the pair's contact distance, R_X the rotation of body X. So a pair couples
 // exactly as two cells of one body do, and cutting a box of whole cells into
 // touching pieces changes nothing but the pairs beyond the cutoff (for other
@@ -223,11 +224,13 @@ void cube_pair_tensor(const double d[3], double h, double volume, double D[6], d
 }
 
 // The volume that turns the cube tensor into one on moments, H = -N mu / V:
-// the cells' volume, as inside a body (magnetics/model.cpp: T = -N / V, V =
-// h^3 for boxes of whole cells); the geometric mean when two bodies' cells
-// stand for different volumes, so that K stays symmetric.
+// the one the body's own tensors use, as inside a body (CellSet::cell_volume:
+// h^3 for volume-share cells and boxes of whole cells, where a boundary cell
+// acts as its cube with the reduced magnetization V_i M / h^3); the geometric
+// mean when two bodies' cells stand for different volumes, so that K stays
+// symmetric.
 double pair_volume(const MagneticModel& model, int i, int j) {
-  return std::sqrt(model.cell_volume(i) * model.cell_volume(j));
+  return std::sqrt(model.body(model.cell_body(i)).cells.cell_volume * model.body(model.cell_body(j)).cells.cell_volume);
 }
 
 // One body frame's share of a pair: T_X = R D(R^T d) R^T (world) and, given the
@@ -300,13 +303,11 @@ class LatticeNearField final : public NearFieldTerm {
       if (body.inert() || !state.active[b] || body.cells.spacing <= 0.0 || body.cell_count() < 3) continue;
       LatticeBody& lb = bodies_[b];
       const double h = body.cells.spacing;
-      const auto& extent = body.cells.lattice_extent;
       for (int i = 0; i < body.cell_count(); ++i) {
         const int c = body.first_cell + i;
-        const auto& index = body.cells.lattice_index[i];
-        const Vec3 local{(index[0] - 0.5 * (extent[0] - 1)) * h, (index[1] - 0.5 * (extent[1] - 1)) * h,
-                         (index[2] - 0.5 * (extent[2] - 1)) * h};  // magnetics/cells.cpp
-        site_[c] = state.pose[b].position + state.pose[b].rotation * local;
+        // The cube's centre: its lattice site for a whole cube, the centroid
+        // of its part of the body for a boundary cell (magnetics/cells.h).
+        site_[c] = state.pose[b].position + state.pose[b].rotation * body.cells.local_positions[i];
         lb.centre += site_[c];
         lb.centroid += state.cell_position[c];
       }

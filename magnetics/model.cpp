@@ -1,5 +1,7 @@
 #include "magnetics/model.h"
 
+#include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -10,11 +12,13 @@ namespace odemag {
 namespace {
 
 // Intra-body tensors act on moments mu = M V (H = T mu). The cube-cube tensor
-// maps magnetization to field (H = -N M), so T = -N / V with V the cell's own
-// volume: the intra-body operator is then that of the cube tiling whatever V
-// is (V differs from h^3 for shapes that are not boxes of whole cells), and
-// keeps its stability. (Dividing by h^3 instead made a cylinder's cells, with
-// V = 1.13 h^3, hold each other saturated: a spurious remanence.)
+// maps magnetization to field (H = -N M), so T = -N / h^3: a cell of volume
+// V_j = w_j h^3 (w_j <= 1, its cube's share inside the body) acts as its cube
+// carrying the reduced magnetization w_j M_j. The operator then stays that of
+// a tiling by cubes of magnetization w M, whose energy is positive, so it
+// keeps its stability. (Scaling up instead, T = -N / V with V = 1.13 h^3 the
+// mean volume a cylinder's cells had, made them hold each other saturated: a
+// spurious remanence.)
 void build_offset_tensors(MagneticBody& body, IntraBodyTensor kind) {
   const auto& n = body.cells.lattice_extent;
   body.offset_extent = {2 * n[0] - 1, 2 * n[1] - 1, 2 * n[2] - 1};
@@ -33,9 +37,97 @@ void build_offset_tensors(MagneticBody& body, IntraBodyTensor kind) {
         } else {
           double n_tensor[6];
           cube_demag_tensor(di, dj, dk, h, n_tensor);
-          for (int a = 0; a < 6; ++a) t[a] = -n_tensor[a] / body.cells.cell_volume;
+          for (int a = 0; a < 6; ++a) t[a] = -n_tensor[a] / body.cells.cell_volume;  // cell_volume = h^3
         }
       }
+}
+
+// Boundary correction (docs/model.md "Cells"). For a uniform magnetization M
+// the cells' field is H_i = -(I/3 + sum_{j != i} w_j N_ij) M (self term and
+// cube tensors of the cubes at the lattice sites, w_j = V_j / h^3), while the
+// body's exact field averaged over cell i's part is -Nbar_i M
+// (magnetics/cells.h uniform_demag_over_cell). Adding
+//   K_i = I/3 + sum_{j != i} w_j N_ij - Nbar_i
+// as H_i += K_i M_i = (K_i / V_i) mu_i gives a uniformly magnetized body its
+// exact field in every cell, but K_i softens boundary cells along the surface,
+// and with it the divergence-free swirl modes, which the continuum leaves at
+// zero energy, went below zero: the intra-body operator of a chi = infinity
+// ball had a negative eigenvalue from R = 10 h on (-4.4e-4, -9.2e-4 at 10 h,
+// 12 h), a spurious remanence. So the correction comes in two parts, each
+// keeping the operator provably positive:
+//
+// 1. Local: K_i limited to K'_i. The cells' energy is that of the tiling by
+//    cubes of magnetization w M (positive) plus, per cell, V_i M_i . ((gamma_D
+//    - w_i / 3) I - K'_i) M_i / 2, so eigenvalues of K'_i up to (1 - w_i) / 3
+//    are safe. Larger eigenvalues of K_i are cut to that bound, and what was
+//    cut is added to the cell's other eigenvalues, up to the same bound.
+// 2. Uniform modes: with the local part, the operator A (A M = W H_applied,
+//    W = diag(V)) applied to a uniform M gives W Pi M per cell, Pi_i =
+//    gamma_D I - K'_i + sum_{j != i} w_j N_ij, where the exact field needs W
+//    beta M, beta_i = (gamma_D - 1/3) I + Nbar_i. The update
+//      A' = A - (A U)(U^T A U)^-1 (A U)^T + B (U^T B)^-1 B^T
+//    (U the uniform fields, A U = W Pi, B = W beta; the BFGS update) gives A' U
+//    = B exactly and stays positive definite since U^T B = sum V beta (the
+//    body's magnetometric demagnetising tensor plus 1/chi) is. It adds to
+//    cell i's field Pi_i G_Pi sum_j Pi_j mu_j - beta_i G_beta sum_j beta_j mu_j.
+// So a lattice ball in a uniform field takes the continuum sphere's moment (its
+// solution is uniform), and the local part carries the boundary correction to
+// non-uniform fields (a chi = 1000 ball next to a point dipole, docs/model.md).
+void build_boundary_correction(MagneticBody& body) {
+  const CellSet& cells = body.cells;
+  const int count = cells.size();
+  const double gamma = body.kind == CellKind::soft ? body.soft.gamma_D : 1.0 / 3.0 + 1.0 / body.recoil;
+  body.self_tensors.assign(6u * count, 0.0);
+  body.uniform_tensors.assign(12u * count, 0.0);
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int i = 0; i < count; ++i) {
+    double nbar[6], sum[6] = {0, 0, 0, 0, 0, 0};
+    uniform_demag_over_cell(body.shape, cells, i, nbar);
+    for (int j = 0; j < count; ++j) {
+      if (j == i) continue;
+      const double* t = &body.offset_tensors[6u * body.offset_index(cells.lattice_index[i], cells.lattice_index[j])];
+      const double v = cells.volumes[j];  // w_j N = -T V_j
+      for (int a = 0; a < 6; ++a) sum[a] -= v * t[a];
+    }
+    auto matrix = [](const double* t) {
+      Eigen::Matrix3d m;
+      m << t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5];
+      return m;
+    };
+    const Eigen::Matrix3d S = matrix(sum), Nbar = matrix(nbar), I = Eigen::Matrix3d::Identity();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I / 3.0 + S - Nbar);
+    Eigen::Vector3d e = eig.eigenvalues();  // ascending
+    const double cap = (1.0 - cells.volumes[i] / cells.cell_volume) / 3.0;
+    double cut = 0.0;
+    for (int q = 0; q < 3; ++q)
+      if (e(q) > cap) cut += e(q) - cap, e(q) = cap;
+    for (int q = 2; q >= 0 && cut > 0.0; --q) {
+      const double add = std::min(cap - e(q), cut);
+      e(q) += add, cut -= add;
+    }
+    const Eigen::Matrix3d K = eig.eigenvectors() * e.asDiagonal() * eig.eigenvectors().transpose();
+    const Eigen::Matrix3d Pi = gamma * I - K + S, beta = (gamma - 1.0 / 3.0) * I + Nbar;
+    const double inv_v = 1.0 / cells.volumes[i];
+    auto store = [](const Eigen::Matrix3d& m, double* out, double scale) {
+      const double c[6] = {m(0, 0), m(0, 1), m(0, 2), m(1, 1), m(1, 2), m(2, 2)};
+      for (int a = 0; a < 6; ++a) out[a] = scale * c[a];
+    };
+    store(K, &body.self_tensors[6u * i], inv_v);
+    store(Pi, &body.uniform_tensors[12u * i], 1.0);
+    store(beta, &body.uniform_tensors[12u * i + 6], 1.0);
+  }
+  for (int k = 0; k < 2; ++k) {
+    Eigen::Matrix3d total = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < count; ++i) {
+      const double* t = &body.uniform_tensors[12u * i + 6u * k];
+      Eigen::Matrix3d m;
+      m << t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5];
+      total += cells.volumes[i] * m;
+    }
+    const Eigen::Matrix3d inv = total.inverse();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) body.uniform_inverse[k].m[r][c] = inv(r, c);
+  }
 }
 
 }  // namespace
@@ -67,7 +159,10 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     body.soft.n = sm->moments_per_cell;
     body.coil_field = sm->coil_field;
   }
-  if (body.responsive() && body.cell_count() > 1) build_offset_tensors(body, intra_tensor_);
+  if (body.responsive() && body.cell_count() > 1) {
+    build_offset_tensors(body, intra_tensor_);
+    if (!body.cells.whole_cells && intra_tensor_ == IntraBodyTensor::cell_average) build_boundary_correction(body);
+  }
 
   for (int c = 0; c < body.cell_count(); ++c) {
     cell_body_.push_back(body_count());

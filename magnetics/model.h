@@ -36,11 +36,24 @@ struct MagneticBody {
   double recoil = 0.0;   // chi_r for permanent bodies
 
   // Intra-body interaction tensors, computed once per body: H = T(d) mu for
-  // every lattice offset d (six components, body frame). T = -N(d) / V with N
-  // the cube-cube tensor and V the cell volume, or the point dipole
-  // (magnetics/demag_tensor.h).
+  // every lattice offset d (six components, body frame). T = -N(d) / h^3 with N
+  // the cube-cube tensor, or the point dipole (magnetics/demag_tensor.h).
   std::vector<double> offset_tensors;
   std::array<int, 3> offset_extent{0, 0, 0};  // 2 n - 1 per axis
+  // Boundary correction of the intra-body field of a responsive body with
+  // partial cells (docs/model.md "Cells"; magnetics/state.h add_boundary_field),
+  // body frame, six components per symmetric tensor. Empty when not needed
+  // (bodies of whole cells, one cell, point-dipole tensors).
+  //  - self_tensors: per cell S_i, adding S_i mu_i to the cell's field (the
+  //    local correction, limited so that the operator stays positive);
+  //  - uniform_tensors: per cell Pi_i then beta_i (twelve numbers), with
+  //    uniform_inverse = ((sum_j V_j Pi_j)^-1, (sum_j V_j beta_j)^-1): the
+  //    correction of the uniform modes, adding
+  //      Pi_i G_Pi sum_j Pi_j mu_j - beta_i G_beta sum_j beta_j mu_j,
+  //    so that a uniform magnetization gets the exact field of the shape.
+  std::vector<double> self_tensors;
+  std::vector<double> uniform_tensors;
+  Mat3 uniform_inverse[2];
 
   int cell_count() const { return cells.size(); }
   bool inert() const { return cells.size() == 0; }
@@ -71,9 +84,16 @@ class MagneticModel {
 
   int cell_count() const { return static_cast<int>(cell_body_.size()); }
   int cell_body(int c) const { return cell_body_[c]; }
-  // Volume (m^3) a cell stands for, and its contact radius (m; CellSet).
-  double cell_volume(int c) const { return bodies_[cell_body_[c]].cells.cell_volume; }
-  double cell_contact_radius(int c) const { return bodies_[cell_body_[c]].cells.contact_radius; }
+  // Volume (m^3) of cell c's part of its body: mu = M V (CellSet::volumes).
+  double cell_volume(int c) const {
+    const MagneticBody& b = bodies_[cell_body_[c]];
+    return b.cells.volumes[c - b.first_cell];
+  }
+  // Contact radius (m) of cell c (CellSet::contact_radii).
+  double cell_contact_radius(int c) const {
+    const MagneticBody& b = bodies_[cell_body_[c]];
+    return b.cells.contact_radii[c - b.first_cell];
+  }
   // Index of the cell's first moment in the state's moment array, -1 if not soft.
   int moment_offset(int c) const { return moment_offset_[c]; }
   int moment_count() const { return moment_count_; }

@@ -294,7 +294,7 @@ void field_at_points(const MagneticModel& model, const MagneticState& state,
 double magnetic_energy(const MagneticModel& model, const MagneticState& state, bool near_field) {
   NearField near;
   near.build(model, state, near_field);
-  double e = near.energy(model, state);
+  double e = near.energy(model, state) + boundary_field_energy(model, state);
   const int n = model.cell_count();
   for (int a = 0; a < n; ++a) {
     const int ba = model.cell_body(a);

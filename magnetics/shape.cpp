@@ -7,13 +7,6 @@
 namespace odemag {
 
 namespace {
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
-
 bool positive(double v) { return std::isfinite(v) && v > 0.0; }
 }  // namespace
 

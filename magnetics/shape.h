@@ -23,6 +23,15 @@ struct Cylinder {
 
 using Shape = std::variant<Sphere, Box, Cylinder>;
 
+// One lambda per shape for std::visit: std::visit(Overloaded{[](const Sphere&)
+// {...}, [](const Box&) {...}, [](const Cylinder&) {...}}, shape).
+template <class... Ts>
+struct Overloaded : Ts... {
+  using Ts::operator()...;
+};
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
 double shape_volume(const Shape& shape);
 // Half extents of the axis-aligned bounding box in the body frame.
 Vec3 shape_half_extents(const Shape& shape);

@@ -66,7 +66,7 @@ void extend_state(const MagneticModel& model, MagneticState& state);
 void reset_moments(const MagneticModel& model, MagneticState& state, int body);
 
 // World cell positions from the body poses, and the magnetization of every
-// cell that follows from its material and pose (MODEL.md "One rigid step", 1).
+// cell that follows from its material and pose (docs/architecture.md "One magnetic step", 1).
 void place_cells(const MagneticModel& model, MagneticState& state);
 
 // Magnetization of one cell from the state (soft: Ms mean(m_k) rotated to world).
@@ -74,5 +74,14 @@ Vec3 soft_cell_magnetization(const MagneticModel& model, const MagneticState& st
 
 // Total moment of a body, sum of M V over its cells, world, A m^2.
 Vec3 body_moment(const MagneticModel& model, const MagneticState& state, int body);
+
+// Adds the boundary correction of the intra-body field (MagneticBody::
+// self_tensors, uniform_tensors; docs/model.md "Cells") at the current
+// magnetizations to every cell of the active responsive bodies that have one.
+// Both backends call it from responsive_field; O(cells).
+void add_boundary_field(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& H);
+
+// Its share of the magnetic energy, J: -mu0/2 sum over those cells of mu . dH.
+double boundary_field_energy(const MagneticModel& model, const MagneticState& state);
 
 }  // namespace odemag

@@ -9,17 +9,11 @@
 
 #include "demos/render/png_writer.h"
 #include "magnetics/relax.h"
+#include "magnetics/shape.h"
 
 namespace odemag {
 
 namespace {
-
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
 
 RenderColor to_color(const std::array<double, 3>& c) {
   return {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])};
