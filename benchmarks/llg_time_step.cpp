@@ -1,6 +1,6 @@
-// The pseudo time step of the LLG update (MODEL.md: "choose, document, and
-// show"): largest rise of the cell free energy per step, relative to the
-// field scale S, for tau = 0.1 .. 2 in dt = tau (1 + alpha^2) / (gamma0 S),
+// The pseudo time step of the LLG update (docs/model.md "LLG integration",
+// pseudo time step): largest rise of the cell free energy per step, relative
+// to the field scale S, for tau = 0.1 .. 2 in dt = tau (1 + alpha^2) / (gamma0 S),
 // over 3000 steps from a generic start, for several fields and anisotropies.
 // The scheme is energy-stable (App. B) where the rise is at round-off.
 // Output: CSV on stdout.

@@ -1,7 +1,8 @@
 // Iterations and error of the per-cell relaxation against the exact single-cell
 // answer M = min(|H_A| / gamma_D, Ms) along H_A, for |H_A| = 1e1 .. 1e7 A/m
-// (MODEL.md asks for this table; docs/model.md shows it). Compares the paper's
-// plain LLG iteration (Algorithm 1 on one cell) with the two-level inner solver.
+// (docs/model.md "Relaxation: two levels instead of Algorithm 1" shows it).
+// Compares the paper's plain LLG iteration (Algorithm 1 on one cell) with the
+// two-level inner solver.
 // Output: CSV on stdout.
 #include <cmath>
 #include <cstdio>

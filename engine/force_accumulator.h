@@ -1,5 +1,5 @@
 // Things that add forces and torques to ODE bodies before each rigid step
-// (MODEL.md "One rigid step", 4: dBodyAddForce / dBodyAddTorque).
+// (docs/embedding.md "The API in one loop", 4: dBodyAddForce / dBodyAddTorque).
 #pragma once
 
 namespace odemag {

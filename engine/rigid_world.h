@@ -1,5 +1,6 @@
 // The ODE side of a scene: world, collision space, contact joints, one ODE
-// body and geom per scene body, a ground plane (MODEL.md "One rigid step", 5).
+// body and geom per scene body, a ground plane (docs/simulation.md "Bodies",
+// "Contacts").
 #pragma once
 
 #include <ode/ode.h>

@@ -1,6 +1,6 @@
-// Scene files (INTERFACE.md "Scene files"; docs/scene-format.md documents every
-// key). A SceneDescription is the validated, SI-unit content of one file: the
-// demos, the tests, the benchmarks and `odemag` all read scenes through it.
+// Scene files (docs/scene-format.md documents every key). A SceneDescription is
+// the validated, SI-unit content of one file: the demos, the tests, the
+// benchmarks and `odemag` all read scenes through it.
 #pragma once
 
 #include <array>
@@ -164,7 +164,7 @@ struct SceneDescription {
   double body_cell_size(int b) const;
 };
 
-// Lattice spacing of a body (INTERFACE.md): its own cell_size if given;
+// Lattice spacing of a body (docs/scene-format.md "Bodies"): its own cell_size if given;
 // otherwise one cell for a sphere and the scene's cell_size for the rest.
 double lattice_spacing(const BodyDescription& body, double scene_cell_size);
 

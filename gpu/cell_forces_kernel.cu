@@ -1,6 +1,6 @@
 // forces, per cell: the force on each cell and the field at it from every cell
-// of the other bodies (pairs inside a body cancel; MODEL.md "Forces and
-// torques"). One thread per cell, sources in shared-memory tiles, summed in
+// of the other bodies (pairs inside a body cancel; docs/model.md "Forces
+// and torques"). One thread per cell, sources in shared-memory tiles, summed in
 // cell order. The per-body sums run on the host in the CPU backend's order.
 #include "gpu/cuda_check.cuh"
 #include "gpu/device_data.cuh"

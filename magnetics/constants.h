@@ -1,4 +1,4 @@
-// Physical constants in SI units (MODEL.md "Units").
+// Physical constants in SI units (docs/embedding.md "The API in one loop", Units).
 #pragma once
 
 namespace odemag {

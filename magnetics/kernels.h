@@ -1,6 +1,7 @@
 // The dipole interaction kernel: one place for the field, force and torque
-// between two cells (MODEL.md "Effective field", "Forces and torques",
-// "Hard cases"; docs/model.md derives the overlap form).
+// between two cells (docs/model.md "Effective field", "Forces and torques";
+// docs/hard-cases.md "Overlapping cells: the bounded core"; docs/model.md
+// "Inter-body kernel and overlapping cells" derives the overlap form).
 //
 // The field of a moment mu at offset r is H = T(r) mu with T the Hessian of
 // g(r) = 1 / (4 pi |r|):  T = A(r) I + B(r) r r^T,
@@ -67,7 +68,7 @@ ODEMAG_HD Vec3 dipole_force(const Vec3& r, const Vec3& mu_a, const Vec3& mu_b, d
 
 // Torque (N m) about a body's centre of mass of one of its cells at offset
 // r_from_centre, with force F on it, moment mu and field H there from the
-// other bodies and H_E: tau = r x F + mu0 mu x H (MODEL.md).
+// other bodies and H_E: tau = r x F + mu0 mu x H (docs/model.md "Forces and torques").
 ODEMAG_HD Vec3 cell_torque(const Vec3& r_from_centre, const Vec3& F, const Vec3& mu, const Vec3& H) {
   return cross(r_from_centre, F) + kMu0 * cross(mu, H);
 }

@@ -1,5 +1,5 @@
-// Per-cell magnetization dynamics (MODEL.md "Effective field on moment k",
-// "Landau-Lifshitz-Gilbert, integrated"; paper Sections 3.4, 4.4, 4.6).
+// Per-cell magnetization dynamics (docs/model.md "Effective field", "LLG integration";
+// paper Sections 3.4, 4.4, 4.6).
 //
 // A soft cell holds n unit moments m_k (stored in the body frame); its
 // magnetization is M = Ms * mean(m_k). Under a frozen applied field H_A (the

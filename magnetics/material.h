@@ -1,4 +1,4 @@
-// Magnetic materials (MODEL.md "Objects and materials"). All values in SI units.
+// Magnetic materials (docs/scene-format.md "Materials"). All values in SI units.
 #pragma once
 
 #include <limits>
@@ -33,7 +33,7 @@ struct SoftMaterial {
   Vec3 coil_field;
 
   // Demagnetising factor of a spherical cell including the intrinsic
-  // susceptibility: gamma_D = 1/3 + 1/chi (MODEL.md, H_endo).
+  // susceptibility: gamma_D = 1/3 + 1/chi (docs/model.md "Summary of choices", self term).
   double demag_factor() const;
   bool anisotropic() const { return anisotropy_field > 0.0; }
 };

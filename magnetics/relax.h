@@ -1,5 +1,6 @@
-// Relaxation of the magnetization for bodies held in place (MODEL.md
-// "Relaxation loop"; paper Algorithm 1), and the rest of a magnetic step.
+// Relaxation of the magnetization for bodies held in place (docs/model.md
+// "Relaxation: two levels instead of Algorithm 1"; paper Algorithm 1), and the
+// rest of a magnetic step.
 #pragma once
 
 #include <vector>
@@ -71,7 +72,7 @@ struct RelaxReport {
 RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxOptions& options,
                   MagneticBackend& backend);
 
-// relax, then per-body forces and torques (MODEL.md "One rigid step", 1-4).
+// relax, then per-body forces and torques (docs/architecture.md "One magnetic step").
 RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
                           const RelaxOptions& options, MagneticBackend& backend);
 

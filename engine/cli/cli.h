@@ -1,4 +1,4 @@
-// The odemag command-line program (INTERFACE.md "Commands"): argument parsing,
+// The odemag command-line program (README.md "Using it"): argument parsing,
 // the points reader and the subcommands. main.cpp dispatches; every command
 // returns its exit status or throws (UsageError, SceneError: exit 2; any
 // other exception: exit 1).
@@ -87,7 +87,7 @@ std::string scene_argument(const std::string& command, const Arguments& args);
 std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene, const SolveOptions& o);
 
 // The commands. solve and field write their whole output at once; run writes
-// its files atomically (docs/run-output.md). Each returns the exit status.
+// its files atomically (docs/hard-cases.md "Output safety"). Each returns the exit status.
 int run_solve(const std::vector<std::string>& args);
 int run_field(const std::vector<std::string>& args);
 

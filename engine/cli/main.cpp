@@ -1,4 +1,4 @@
-// odemag: the command-line program (INTERFACE.md "Commands").
+// odemag: the command-line program (README.md "Using it").
 //
 // Exit status: 0 done; 2 bad input or usage, with one line on stderr naming
 // the file and the offending key; 1 anything else. Commands build their whole

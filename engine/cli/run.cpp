@@ -1,5 +1,6 @@
 // `odemag run SCENE --out DIR`: simulate with ODE and write per-frame state,
-// frames (when a renderer is available) and a summary (docs/run-output.md).
+// frames (when a renderer is available) and a summary (docs/hard-cases.md
+// "Output safety").
 #include <unistd.h>
 
 #include <algorithm>

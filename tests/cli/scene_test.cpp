@@ -1,5 +1,5 @@
-// The scene loader: the INTERFACE.md example, every other key, and each class
-// of rejection with the key path it must name.
+// The scene loader: examples/bar_and_ball.json (docs/scene-format.md), every
+// other key, and each class of rejection with the key path it must name.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -96,8 +96,8 @@ TEST(SceneParser, InterfaceExample) {
   EXPECT_EQ(ball.density, 7870.0);
   EXPECT_FALSE(ball.fixed);
   EXPECT_TRUE(ball.present);
-  // INTERFACE.md: a sphere without a cell_size of its own is one cell; the
-  // bar inherits the scene's spacing.
+  // docs/scene-format.md "Bodies": a sphere without a cell_size of its own is
+  // one cell; the bar inherits the scene's spacing.
   EXPECT_FALSE(ball.cell_size.has_value());
   EXPECT_EQ(s.body_cell_size(1), 0.0);
   EXPECT_EQ(s.body_cell_size(0), 0.004);

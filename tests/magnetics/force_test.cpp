@@ -1,4 +1,5 @@
-// Forces and torques (MODEL.md "Forces and torques", "Hard cases"):
+// Forces and torques (docs/model.md "Forces and torques"; docs/hard-cases.md
+// "Overlapping cells: the bounded core"):
 // F = -grad U and tau = -dU/dtheta for fixed moments, zero net force and
 // balanced angular momentum for a closed system, bounded overlap kernel.
 #include <gtest/gtest.h>
@@ -134,9 +135,9 @@ TEST(Forces, UniformFieldGivesTorqueButNoForce) {
   EXPECT_LT(norm(state.torque[0] - expected), 1e-12 * norm(expected));
 }
 
-// MODEL.md "Hard cases": two one-cell magnets swept from three contact radii to
-// coincident: the force stays finite and continuous and equals the exact
-// dipole force beyond contact.
+// docs/hard-cases.md "Overlapping cells: the bounded core": two one-cell
+// magnets swept from three contact radii to coincident: the force stays finite
+// and continuous and equals the exact dipole force beyond contact.
 TEST(Forces, OverlapSweepIsBoundedContinuousAndExactBeyondContact) {
   const double R = 0.005, s = 2 * R;
   const Vec3 mu_a{0.1, 0.05, 0.3}, mu_b{-0.2, 0.1, 0.25};

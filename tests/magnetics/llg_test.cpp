@@ -1,5 +1,5 @@
-// Tests of the per-cell LLG physics (magnetics/llg.h): MODEL.md "Properties
-// the tests must show" and the paper's App. B, App. C, Figs. 10 and 11.
+// Tests of the per-cell LLG physics (magnetics/llg.h): docs/model.md "LLG
+// integration" and the paper's App. B, App. C, Figs. 10 and 11.
 #include "magnetics/llg.h"
 
 #include <gtest/gtest.h>
