@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "demos/view/scene_view.h"
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 
 namespace {
 

@@ -175,7 +175,7 @@ RenderScene render_scene_of(const Simulation& sim, const ViewOptions& options, M
 
 namespace {
 
-class PngFrameWriter final : public cli::FrameWriter {
+class PngFrameWriter final : public FrameWriter {
  public:
   explicit PngFrameWriter(const SceneDescription& scene)
       : options_(view_options(scene)),
@@ -198,7 +198,7 @@ class PngFrameWriter final : public cli::FrameWriter {
 
 }  // namespace
 
-std::unique_ptr<cli::FrameWriter> make_png_frame_writer(const SceneDescription& scene) {
+std::unique_ptr<FrameWriter> make_png_frame_writer(const SceneDescription& scene) {
   return std::make_unique<PngFrameWriter>(scene);
 }
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "demos/render/renderer.h"
-#include "engine/cli/cli.h"
+#include "engine/frame_writer.h"
 #include "engine/simulation.h"
 
 namespace odemag {
@@ -36,6 +36,6 @@ RenderScene render_scene_of(const Simulation& sim, const ViewOptions& options,
                             MagneticBackend* field_backend);
 
 // Frames for `odemag run`: renders with OSMesa and writes PNGs atomically.
-std::unique_ptr<cli::FrameWriter> make_png_frame_writer(const SceneDescription& scene);
+std::unique_ptr<FrameWriter> make_png_frame_writer(const SceneDescription& scene);
 
 }  // namespace odemag

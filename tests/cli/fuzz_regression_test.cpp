@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 #include "engine/scene.h"
 
 namespace odemag {

@@ -1,7 +1,7 @@
 // The points file of `odemag field` and the argument parser of the commands.
 #include <gtest/gtest.h>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 #include "engine/scene.h"
 
 namespace odemag::cli {

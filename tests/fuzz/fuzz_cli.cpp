@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 
 namespace {
 

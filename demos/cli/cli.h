@@ -14,6 +14,7 @@
 
 #include <memory>
 
+#include "engine/frame_writer.h"
 #include "engine/scene.h"
 #include "magnetics/backend.h"
 #include "magnetics/vec3.h"
@@ -91,14 +92,8 @@ std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene, co
 int run_solve(const std::vector<std::string>& args);
 int run_field(const std::vector<std::string>& args);
 
-// Draws frames of a running simulation (the OSMesa renderer in demos/
-// provides one; without it `run` writes no frames).
-class FrameWriter {
- public:
-  virtual ~FrameWriter() = default;
-  // Writes the current state as a PNG at path (atomically).
-  virtual void write(const Simulation& simulation, const std::string& path) = 0;
-};
+// Frames of a running simulation (engine/frame_writer.h; the OSMesa renderer
+// in demos/view provides one; without it `run` writes no frames).
 using FrameWriterFactory =
     std::function<std::unique_ptr<FrameWriter>(const SceneDescription& scene)>;
 int run_simulation(const std::vector<std::string>& args, const FrameWriterFactory& frames);

@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 #include "engine/simulation.h"
 
 namespace odemag::cli {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 
 namespace odemag::cli {
 

@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 #include "engine/magnetic_scene.h"
 #include "engine/scene.h"
 #include "magnetics/relax.h"

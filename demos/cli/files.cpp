@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 
 namespace odemag::cli {
 

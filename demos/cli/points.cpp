@@ -9,7 +9,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 #include "engine/scene.h"
 
 namespace odemag::cli {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/cli/cli.h"
+#include "demos/cli/cli.h"
 #ifdef ODEMAG_WITH_RENDERER
 #include "demos/view/scene_view.h"
 #endif
