@@ -57,8 +57,8 @@
 
 #include "benchmarks/bench_common.h"
 #include "benchmarks/timed_backend.h"
-#include "engine/scene.h"
-#include "engine/simulation.h"
+#include "engine/scene/scene.h"
+#include "engine/sim/simulation.h"
 #include "magnetics/backend.h"
 #include "magnetics/demag_tensor.h"
 #include "magnetics/relax.h"

@@ -3,23 +3,29 @@
 # targets are defined.
 #
 # Installed: the libraries odemag::magnetics, odemag::gpu (the CUDA backend or
-# its stub), odemag::scene and odemag::engine, the umbrella odemag::odemag,
-# the headers under include/odemag/{magnetics,engine,gpu} (so that
-# #include "engine/magnetic_forces.h" works as in the source tree) and the
-# odemag program. odemag_warnings and odemag_tuning (-march=native) are
+# its stub), odemag::ode (the embedding library: MagneticForces and the force
+# accumulators, magnetics + ODE only), odemag::scene (scene files),
+# odemag::engine (the simulation) and the umbrella odemag::odemag; the public
+# headers (ODEMAG_PUBLIC_HEADERS below: the embedding, scene-loading and
+# simulation headers and the magnetics headers they include) under
+# include/odemag/ with their source paths, so that
+# #include "engine/ode/magnetic_forces.h" works as in the source tree; and
+# the odemag program. Everything else is private, in particular the SIMD
+# kernels (magnetics/simd.h, pair_sums.h), whose intrinsics are chosen by the
+# compiler flags. odemag_warnings and odemag_tuning (-march=native) are
 # build-only: the libraries link them as $<BUILD_INTERFACE:...>, so consumers
 # compile with their own flags.
 include(CMakePackageConfigHelpers)
 
 set(ODEMAG_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/odemag)
 
-# odemag::odemag: everything an ODE program needs to embed odemag.
+# odemag::odemag: everything an ODE program needs to load and run scenes.
 add_library(odemag_all INTERFACE)
 target_link_libraries(odemag_all INTERFACE odemag_engine)
 set_target_properties(odemag_all PROPERTIES EXPORT_NAME odemag)
 add_library(odemag::odemag ALIAS odemag_all)
 
-install(TARGETS odemag_magnetics odemag_gpu odemag_scene odemag_engine odemag_all
+install(TARGETS odemag_magnetics odemag_gpu odemag_ode odemag_scene odemag_engine odemag_all
   EXPORT odemagTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
@@ -28,11 +34,21 @@ install(TARGETS odemag_magnetics odemag_gpu odemag_scene odemag_engine odemag_al
 # (INSTALL_INTERFACE in magnetics/CMakeLists.txt), which all of them link.
 install(TARGETS odemag RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 
-file(GLOB ODEMAG_MAGNETICS_HEADERS ${PROJECT_SOURCE_DIR}/magnetics/*.h)
-file(GLOB ODEMAG_ENGINE_HEADERS ${PROJECT_SOURCE_DIR}/engine/*.h)
-install(FILES ${ODEMAG_MAGNETICS_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/odemag/magnetics)
-install(FILES ${ODEMAG_ENGINE_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/odemag/engine)
-install(FILES ${PROJECT_SOURCE_DIR}/gpu/cuda_backend.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/odemag/gpu)
+# The public API: three entry headers and what they include (closed under
+# #include; tests/install/install_test.cmake checks that).
+set(ODEMAG_PUBLIC_HEADERS
+  engine/ode/magnetic_forces.h engine/ode/force_accumulator.h       # embedding
+  engine/scene/scene.h                                              # scene loading
+  engine/sim/simulation.h engine/sim/rigid_world.h engine/sim/frame_writer.h
+  engine/sim/magnetic_scene.h                                       # simulation
+  gpu/cuda_backend.h
+  magnetics/backend.h magnetics/cells.h magnetics/constants.h magnetics/demag_tensor.h
+  magnetics/hd.h magnetics/llg.h magnetics/material.h magnetics/model.h magnetics/relax.h
+  magnetics/rng.h magnetics/shape.h magnetics/small_eigen.h magnetics/state.h magnetics/vec3.h)
+foreach(header IN LISTS ODEMAG_PUBLIC_HEADERS)
+  get_filename_component(dir ${header} DIRECTORY)
+  install(FILES ${PROJECT_SOURCE_DIR}/${header} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/odemag/${dir})
+endforeach()
 
 install(EXPORT odemagTargets
   NAMESPACE odemag::

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "engine/magnetic_forces.h"
+#include "engine/ode/magnetic_forces.h"
 
 static dWorldID world;
 static dJointGroupID contacts;

@@ -14,8 +14,8 @@
 
 #include <memory>
 
-#include "engine/frame_writer.h"
-#include "engine/scene.h"
+#include "engine/sim/frame_writer.h"
+#include "engine/scene/scene.h"
 #include "magnetics/backend.h"
 #include "magnetics/vec3.h"
 
@@ -92,7 +92,7 @@ std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene, co
 int run_solve(const std::vector<std::string>& args);
 int run_field(const std::vector<std::string>& args);
 
-// Frames of a running simulation (engine/frame_writer.h; the OSMesa renderer
+// Frames of a running simulation (engine/sim/frame_writer.h; the OSMesa renderer
 // in demos/view provides one; without it `run` writes no frames).
 using FrameWriterFactory =
     std::function<std::unique_ptr<FrameWriter>(const SceneDescription& scene)>;

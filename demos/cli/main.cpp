@@ -13,7 +13,7 @@
 #ifdef ODEMAG_WITH_RENDERER
 #include "demos/view/scene_view.h"
 #endif
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace {
 

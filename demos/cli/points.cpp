@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "demos/cli/cli.h"
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace odemag::cli {
 

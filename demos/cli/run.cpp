@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "demos/cli/cli.h"
-#include "engine/simulation.h"
+#include "engine/sim/simulation.h"
 
 namespace odemag::cli {
 

@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "demos/cli/cli.h"
-#include "engine/magnetic_scene.h"
-#include "engine/scene.h"
+#include "engine/sim/magnetic_scene.h"
+#include "engine/scene/scene.h"
 #include "magnetics/relax.h"
 
 namespace odemag::cli {

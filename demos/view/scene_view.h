@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "demos/render/renderer.h"
-#include "engine/frame_writer.h"
-#include "engine/simulation.h"
+#include "engine/sim/frame_writer.h"
+#include "engine/sim/simulation.h"
 
 namespace odemag {
 

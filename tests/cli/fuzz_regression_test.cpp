@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "demos/cli/cli.h"
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace odemag {
 namespace {

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "demos/cli/cli.h"
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace odemag::cli {
 namespace {

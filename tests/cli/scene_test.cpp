@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace odemag {
 namespace {

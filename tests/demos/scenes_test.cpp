@@ -13,8 +13,8 @@
 #include <string>
 #include <variant>
 
-#include "engine/scene.h"
-#include "engine/simulation.h"
+#include "engine/scene/scene.h"
+#include "engine/sim/simulation.h"
 #include "magnetics/backend.h"
 #include "magnetics/constants.h"
 

@@ -24,8 +24,8 @@
 #include <cstring>
 #include <string>
 
-#include "engine/scene.h"
-#include "engine/simulation.h"
+#include "engine/scene/scene.h"
+#include "engine/sim/simulation.h"
 #include "magnetics/backend.h"
 
 namespace odemag {

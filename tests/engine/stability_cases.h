@@ -19,7 +19,7 @@
 #include <variant>
 #include <vector>
 
-#include "engine/simulation.h"
+#include "engine/sim/simulation.h"
 #include "magnetics/constants.h"
 #include "magnetics/kernels.h"
 #include "magnetics/near_field.h"
@@ -235,7 +235,7 @@ inline double available_energy(const CaseResult& r, bool started_overlapping) {
 inline constexpr int kPenetrationBodies = 64;
 
 // How much larger than its shape a body's collision geometry is (the
-// collision skin of engine/rigid_world.cpp), read back from ODE.
+// collision skin of engine/sim/rigid_world.cpp), read back from ODE.
 inline double collision_skin(dGeomID g, const Shape& shape) {
   if (const auto* s = std::get_if<Sphere>(&shape)) return dGeomSphereGetRadius(g) - s->radius;
   if (const auto* b = std::get_if<Box>(&shape)) {

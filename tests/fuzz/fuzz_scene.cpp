@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 namespace {
 

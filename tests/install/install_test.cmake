@@ -28,10 +28,28 @@ function(step name)
 endfunction()
 
 step(install ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix} --config ${BUILD_TYPE})
-foreach(file include/odemag/engine/magnetic_forces.h include/odemag/magnetics/model.h
+foreach(file include/odemag/engine/ode/magnetic_forces.h include/odemag/engine/scene/scene.h
+        include/odemag/engine/sim/simulation.h include/odemag/magnetics/model.h
         include/odemag/gpu/cuda_backend.h bin/odemag)
   if(NOT EXISTS ${prefix}/${file})
     message(FATAL_ERROR "install_test: ${file} was not installed")
+  endif()
+endforeach()
+# The public headers are closed under #include, and the private ones stay
+# private (the SIMD kernels' intrinsics follow the compiler flags).
+file(GLOB_RECURSE installed RELATIVE ${prefix}/include/odemag ${prefix}/include/odemag/*.h)
+foreach(header IN LISTS installed)
+  file(STRINGS ${prefix}/include/odemag/${header} includes REGEX "^[ \t]*#[ \t]*include[ \t]+\"")
+  foreach(line IN LISTS includes)
+    string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]+\"([^\"]+)\".*" "\\1" path "${line}")
+    if(NOT EXISTS ${prefix}/include/odemag/${path})
+      message(FATAL_ERROR "install_test: installed ${header} includes ${path}, which is not installed")
+    endif()
+  endforeach()
+endforeach()
+foreach(private magnetics/simd.h magnetics/pair_sums.h magnetics/kernels.h magnetics/near_field.h)
+  if(EXISTS ${prefix}/include/odemag/${private})
+    message(FATAL_ERROR "install_test: the private header ${private} was installed")
   endif()
 endforeach()
 
@@ -49,6 +67,29 @@ if(SANITIZE)
 endif()
 step(configure ${CMAKE_COMMAND} ${configure_args})
 step(build ${CMAKE_COMMAND} --build ${consumer_build} --config ${BUILD_TYPE})
+
+# The embedding example links the embedding library alone: its link line has
+# no scene library (nlohmann-json), no GPU library or CUDA runtime, no OSMesa.
+set(link_line "")
+if(EXISTS ${consumer_build}/CMakeFiles/embed_minimal.dir/link.txt)
+  file(READ ${consumer_build}/CMakeFiles/embed_minimal.dir/link.txt link_line)
+elseif(EXISTS ${consumer_build}/build.ninja)
+  file(STRINGS ${consumer_build}/build.ninja link_line REGEX "LINK_LIBRARIES")
+endif()
+if(link_line STREQUAL "")
+  message(FATAL_ERROR "install_test: found no link line of embed_minimal in ${consumer_build}")
+endif()
+if(NOT link_line MATCHES "odemag_ode")
+  message(FATAL_ERROR "install_test: embed_minimal does not link odemag_ode: ${link_line}")
+endif()
+foreach(forbidden odemag_scene odemag_engine odemag_gpu cudart OSMesa nlohmann)
+  string(TOLOWER "${link_line}" lower)
+  string(TOLOWER "${forbidden}" f)
+  if(lower MATCHES "${f}")
+    message(FATAL_ERROR "install_test: embed_minimal links ${forbidden}: ${link_line}")
+  endif()
+endforeach()
+message(STATUS "install_test: embed_minimal link line: ${link_line}")
 
 # The program checks itself: 0 when the ball ended up touching the magnet.
 find_program(program embed_minimal PATHS ${consumer_build} ${consumer_build}/${BUILD_TYPE} NO_DEFAULT_PATH)

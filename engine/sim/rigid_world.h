@@ -7,8 +7,8 @@
 
 #include <vector>
 
-#include "engine/force_accumulator.h"
-#include "engine/scene.h"
+#include "engine/ode/force_accumulator.h"
+#include "engine/scene/scene.h"
 #include "magnetics/state.h"
 
 namespace odemag {

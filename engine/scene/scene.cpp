@@ -2,7 +2,7 @@
 //
 // Every value is checked where it is read, and every failure names the file
 // and the JSON key path of the offending value ("bodies[2].shape.sphere").
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 
 #include <cerrno>
 #include <cmath>

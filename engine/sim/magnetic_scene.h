@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "engine/scene.h"
+#include "engine/scene/scene.h"
 #include "magnetics/backend.h"
 #include "magnetics/model.h"
 #include "magnetics/state.h"

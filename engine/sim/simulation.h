@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "engine/magnetic_forces.h"
-#include "engine/rigid_world.h"
-#include "engine/scene.h"
+#include "engine/ode/magnetic_forces.h"
+#include "engine/sim/rigid_world.h"
+#include "engine/scene/scene.h"
 
 namespace odemag {
 

@@ -1,10 +1,10 @@
-#include "engine/rigid_world.h"
+#include "engine/sim/rigid_world.h"
 
 #include <algorithm>
 #include <cstdint>
 #include <variant>
 
-#include "engine/magnetic_forces.h"
+#include "engine/ode/magnetic_forces.h"
 
 namespace odemag {
 

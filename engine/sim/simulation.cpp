@@ -1,4 +1,4 @@
-#include "engine/simulation.h"
+#include "engine/sim/simulation.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <variant>
 
-#include "engine/magnetic_scene.h"
+#include "engine/sim/magnetic_scene.h"
 #include "magnetics/constants.h"
 
 namespace odemag {

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/force_accumulator.h"
+#include "engine/ode/force_accumulator.h"
 #include "magnetics/backend.h"
 #include "magnetics/model.h"
 #include "magnetics/relax.h"

@@ -1,4 +1,4 @@
-#include "engine/magnetic_forces.h"
+#include "engine/ode/magnetic_forces.h"
 
 namespace odemag {
 

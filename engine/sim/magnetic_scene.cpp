@@ -1,4 +1,4 @@
-#include "engine/magnetic_scene.h"
+#include "engine/sim/magnetic_scene.h"
 
 #include <stdexcept>
 

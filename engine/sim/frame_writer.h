@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "engine/simulation.h"
+#include "engine/sim/simulation.h"
 
 namespace odemag {
 
