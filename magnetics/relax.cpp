@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "magnetics/anderson.h"
 #include "magnetics/kernels.h"
@@ -15,6 +16,10 @@ namespace {
 // An Anderson step may move the applied field at most this many times the
 // current (weighted) residual.
 constexpr double kMaxStepPerResidual = 30.0;
+
+// skip_unchanged: a magnetic body may move this fraction of its cell contact
+// radius, and turn this many radians, from the pose last solved for.
+constexpr double kUnchangedDistance = 1e-5, kUnchangedRotation = 1e-5;
 
 std::vector<int> active_responsive_cells(const MagneticModel& model, const MagneticState& state) {
   std::vector<int> cells;
@@ -34,185 +39,6 @@ double cell_field_scale(const MagneticModel& model, const MagneticState& state, 
   const double gamma = body.kind == CellKind::soft ? body.soft.gamma_D : 1.0 / 3.0;
   return norm(H_A) + gamma * norm(state.magnetization[c]);
 }
-
-RelaxReport relax_paper(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
-                        MagneticBackend& backend, const std::vector<int>& cells,
-                        const std::vector<Vec3>& H_fixed) {
-  RelaxReport report;
-  std::vector<Vec3> H(model.cell_count()), H_A(model.cell_count());
-  LocalRelaxOptions local = o.local;
-  local.single_step = true;
-  local.tolerance = o.tolerance;
-  // Every iteration re-evaluates the exo field, so the coupling between cells
-  // (eigenvalues of the intra-body operator reach 2 gamma_D Ms) is integrated
-  // explicitly too: its stiffness triples the bound S of the dt rule.
-  local.time_step_factor /= 3.0;
-  for (report.iterations = 0; report.iterations < o.max_iterations; ++report.iterations) {
-    backend.responsive_field(model, state, H);
-    ++report.field_evaluations;
-    for (int c : cells) H_A[c] = H_fixed[c] + (o.mutual_induction ? H[c] : Vec3{});
-    const LocalStats s = backend.relax_cells(model, state, H_A, local);
-    report.llg_steps += s.llg_steps;
-    report.residual = s.max_residual;
-    report.residual_history.push_back(s.max_residual);
-    if (s.llg_steps == 0) {
-      report.converged = true;
-      break;
-    }
-  }
-  for (int c : cells) state.applied_field[c] = H_A[c];
-  return report;
-}
-
-// Electromagnets: the (scaled) coil field acts on the cells of its own core.
-void add_coil_fields(const MagneticModel& model, const MagneticState& state, const std::vector<int>& cells,
-                     std::vector<Vec3>& H) {
-  for (int c : cells) {
-    const int b = model.cell_body(c);
-    const Vec3& coil = model.body(b).coil_field;
-    if (coil.x != 0.0 || coil.y != 0.0 || coil.z != 0.0)
-      H[c] += state.pose[b].rotation * (state.magnetization_scale[b] * coil);
-  }
-}
-
-}  // namespace
-
-RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
-                  MagneticBackend& backend) {
-  place_cells(model, state);
-  backend.set_far_field(o.far_field_theta);
-  backend.set_near_field(o.near_field, o.mutual_induction);
-  backend.begin_step(model, state);
-  const std::vector<int> cells = active_responsive_cells(model, state);
-  if (cells.empty()) {
-    RelaxReport nothing;
-    nothing.converged = true;
-    return nothing;
-  }
-
-  std::vector<Vec3> H_fixed(model.cell_count());
-  backend.fixed_field(model, state, H_fixed);
-  add_coil_fields(model, state, cells, H_fixed);
-  if (o.scheme == RelaxScheme::paper) return relax_paper(model, state, o, backend, cells, H_fixed);
-
-  RelaxReport report;
-  LocalRelaxOptions local = o.local;
-  local.single_step = false;
-  std::vector<Vec3> H_A(model.cell_count()), H_resp(model.cell_count());
-  if (!o.mutual_induction) {
-    for (int c : cells) H_A[c] = H_fixed[c];
-    const LocalStats s = backend.relax_cells(model, state, H_A, local);
-    for (int c : cells) state.applied_field[c] = H_A[c];
-    // Induced cells feel only H_E and fixed magnets: one pass is the solution.
-    report.iterations = 1;
-    report.residual = s.max_residual;
-    report.converged = s.max_residual <= std::max(o.local.tolerance, o.tolerance);
-    report.llg_steps = s.llg_steps;
-    report.newton_steps = s.newton_steps;
-    return report;
-  }
-
-  // x: applied field at the responsive cells, flattened; G(x): the applied
-  // field after relaxing every cell under x.
-  const int n = static_cast<int>(cells.size());
-  std::vector<double> x(3 * n), f(3 * n), weights(3 * n);
-  backend.responsive_field(model, state, H_resp);
-  ++report.field_evaluations;
-  double largest_scale = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const int c = cells[i];
-    const Vec3 h = H_fixed[c] + H_resp[c];
-    for (int a = 0; a < 3; ++a) x[3 * i + a] = h[a];
-    largest_scale = std::max(largest_scale, cell_field_scale(model, state, c, h));
-  }
-  const double floor = 1e-9 * largest_scale + 1e-300;
-  for (int i = 0; i < n; ++i) {
-    const int c = cells[i];
-    const double w = 1.0 / (cell_field_scale(model, state, c, {x[3 * i], x[3 * i + 1], x[3 * i + 2]}) + floor);
-    weights[3 * i] = weights[3 * i + 1] = weights[3 * i + 2] = w;
-  }
-  AndersonMixer mixer(o.anderson_depth, o.mixing);
-  mixer.set_weights(weights);
-  double best_residual = std::numeric_limits<double>::infinity();
-  int last_progress = 0;  // iteration of the last halving of the best residual
-
-  for (report.iterations = 1; report.iterations <= o.max_iterations; ++report.iterations) {
-    for (int i = 0; i < n; ++i) H_A[cells[i]] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
-    // Inexact inner solves: each cell only as accurately as the outer loop
-    // can use now (1% of its last residual), down to the inner tolerance.
-    if (!report.residual_history.empty())
-      local.tolerance = std::max(o.local.tolerance, std::min(1e-6, 1e-2 * report.residual_history.back()));
-    const LocalStats s = backend.relax_cells(model, state, H_A, local);
-    report.llg_steps += s.llg_steps;
-    report.newton_steps += s.newton_steps;
-    backend.responsive_field(model, state, H_resp);
-    ++report.field_evaluations;
-    // Residual: change of each cell's applied field against its field scale.
-    double worst = 0.0, largest = 0.0;
-    std::vector<Vec3> G(n);
-    for (int i = 0; i < n; ++i) {
-      const int c = cells[i];
-      G[i] = H_fixed[c] + H_resp[c];
-      largest = std::max(largest, cell_field_scale(model, state, c, G[i]));
-    }
-    const double fl = 1e-9 * largest + 1e-300;
-    for (int i = 0; i < n; ++i) {
-      const int c = cells[i];
-      const Vec3 d = G[i] - H_A[c];
-      for (int a = 0; a < 3; ++a) f[3 * i + a] = d[a];
-      worst = std::max(worst, norm(d) / (cell_field_scale(model, state, c, G[i]) + fl));
-    }
-    report.residual = worst;
-    report.residual_history.push_back(worst);
-    if (worst <= o.tolerance) {
-      report.converged = true;
-      for (int i = 0; i < n; ++i) H_A[cells[i]] = G[i];
-      break;
-    }
-    // Safeguarded Anderson step. Hysteretic cells make the map x -> G(x)
-    // path-dependent: an extrapolated field that overshoots can switch cells
-    // irreversibly (measured: a remanent nail demagnetized by one bad
-    // iterate). So a step is capped at 30 times the residual (ill-conditioned
-    // bodies such as needles need steps of ~1/(1 - lambda) = 100 times), and
-    // when the residual grows past 10 times the best seen, the history is
-    // dropped and a damped plain step taken instead.
-    double fw = 0.0;
-    for (int i = 0; i < 3 * n; ++i) fw += weights[i] * weights[i] * f[i] * f[i];
-    fw = std::sqrt(fw);
-    if (fw > 10.0 * best_residual) {
-      mixer.reset();
-      for (int i = 0; i < 3 * n; ++i) x[i] += 0.5 * f[i];
-      continue;
-    }
-    // Stagnation (cells switching across a hysteresis jump make x -> G(x)
-    // discontinuous, and the stored differences then describe the other
-    // branch): if the best residual has not halved in 20 iterations, the
-    // history is dropped.
-    if (fw < 0.5 * best_residual) {
-      last_progress = report.iterations;
-    } else if (report.iterations - last_progress >= 20) {
-      mixer.reset();
-      last_progress = report.iterations;
-    }
-    best_residual = std::min(best_residual, fw);
-    const std::vector<double> x_old = x;
-    mixer.next(x, f);
-    double dw = 0.0;
-    for (int i = 0; i < 3 * n; ++i) dw += weights[i] * weights[i] * (x[i] - x_old[i]) * (x[i] - x_old[i]);
-    dw = std::sqrt(dw);
-    if (dw > kMaxStepPerResidual * fw)
-      for (int i = 0; i < 3 * n; ++i) x[i] = x_old[i] + (kMaxStepPerResidual * fw / dw) * (x[i] - x_old[i]);
-  }
-  report.iterations = std::min(report.iterations, o.max_iterations);
-  for (int c : cells) state.applied_field[c] = H_A[c];
-  return report;
-}
-
-namespace {
-
-// skip_unchanged: a magnetic body may move this fraction of its cell contact
-// radius, and turn this many radians, from the pose last solved for.
-constexpr double kUnchangedDistance = 1e-5, kUnchangedRotation = 1e-5;
 
 bool unchanged_since_last_solve(const MagneticModel& model, const MagneticState& state, const RelaxOptions& o) {
   const SolvedInputs& last = state.last_solve;
@@ -245,23 +71,329 @@ void record_solve(MagneticState& state, const RelaxOptions& o, bool converged) {
   last.near_field = o.near_field;
 }
 
-}  // namespace
-
-RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
-                          const RelaxOptions& options, MagneticBackend& backend) {
-  if (options.skip_unchanged && unchanged_since_last_solve(model, state, options)) {
-    RelaxReport skipped;
-    skipped.converged = skipped.skipped = true;
-    return skipped;
+// Electromagnets: the (scaled) coil field acts on the cells of its own core.
+void add_coil_fields(const MagneticModel& model, const MagneticState& state, const std::vector<int>& cells,
+                     std::vector<Vec3>& H) {
+  for (int c : cells) {
+    const int b = model.cell_body(c);
+    const Vec3& coil = model.body(b).coil_field;
+    if (coil.x != 0.0 || coil.y != 0.0 || coil.z != 0.0)
+      H[c] += state.pose[b].rotation * (state.magnetization_scale[b] * coil);
   }
-  RelaxReport report = relax(model, state, options, backend);
+}
+
+RelaxReport relax_paper(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
+                        MagneticBackend& backend, const std::vector<int>& cells,
+                        const std::vector<Vec3>& H_fixed) {
+  RelaxReport report;
+  std::vector<Vec3> H(model.cell_count()), H_A(model.cell_count());
+  LocalRelaxOptions local = o.local;
+  local.single_step = true;
+  local.tolerance = o.tolerance;
+  // Every iteration re-evaluates the exo field, so the coupling between cells
+  // (eigenvalues of the intra-body operator reach 2 gamma_D Ms) is integrated
+  // explicitly too: its stiffness triples the bound S of the dt rule.
+  local.time_step_factor /= 3.0;
+  for (report.iterations = 0; report.iterations < o.max_iterations; ++report.iterations) {
+    backend.responsive_field(model, state, H);
+    ++report.field_evaluations;
+    for (int c : cells) H_A[c] = H_fixed[c] + (o.mutual_induction ? H[c] : Vec3{});
+    const LocalStats s = backend.relax_cells(model, state, H_A, local);
+    report.llg_steps += s.llg_steps;
+    report.residual = s.max_residual;
+    report.residual_history.push_back(s.max_residual);
+    if (s.llg_steps == 0) {
+      report.converged = true;
+      break;
+    }
+  }
+  for (int c : cells) state.applied_field[c] = H_A[c];
+  return report;
+}
+
+// Two-level scheme without mutual induction: one relaxation under the fixed field.
+RelaxReport relax_one_pass(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
+                           MagneticBackend& backend, const std::vector<int>& cells,
+                           const std::vector<Vec3>& H_fixed) {
+  RelaxReport report;
+  LocalRelaxOptions local = o.local;
+  local.single_step = false;
+  std::vector<Vec3> H_A(model.cell_count());
+  for (int c : cells) H_A[c] = H_fixed[c];
+  const LocalStats s = backend.relax_cells(model, state, H_A, local);
+  for (int c : cells) state.applied_field[c] = H_A[c];
+  // Induced cells feel only H_E and fixed magnets: one pass is the solution.
+  report.iterations = 1;
+  report.residual = s.max_residual;
+  report.converged = s.max_residual <= std::max(o.local.tolerance, o.tolerance);
+  report.llg_steps = s.llg_steps;
+  report.newton_steps = s.newton_steps;
+  return report;
+}
+
+// The outer loop of the two-level scheme. x: applied field at the responsive
+// cells, flattened; G(x): the applied field after relaxing every cell under x.
+struct OuterLoop {
+  const MagneticModel& model;
+  MagneticState& state;
+  MagneticBackend& backend;
+  const RelaxOptions& o;
+  const std::vector<int>& cells;
+  const std::vector<Vec3>& H_fixed;
+  LocalRelaxOptions local;
+  std::vector<Vec3> H_A, H_resp;  // by cell: the field x relaxed under; the responsive field after
+};
+
+// Applied field at each responsive cell (in the order of cells): the fixed
+// field plus the last responsive field.
+std::vector<Vec3> fixed_plus_responsive(const OuterLoop& l) {
+  const int n = static_cast<int>(l.cells.size());
+  std::vector<Vec3> G(n);
+  for (int i = 0; i < n; ++i) G[i] = l.H_fixed[l.cells[i]] + l.H_resp[l.cells[i]];
+  return G;
+}
+
+// Floor of the field scales: 1e-9 of the largest at the fields h (one per cell).
+double field_scale_floor(const OuterLoop& l, const std::vector<Vec3>& h) {
+  double largest = 0.0;
+  for (size_t i = 0; i < h.size(); ++i)
+    largest = std::max(largest, cell_field_scale(l.model, l.state, l.cells[i], h[i]));
+  return 1e-9 * largest + 1e-300;
+}
+
+// The initial iterate: the fixed field plus the responsive field of the
+// warm-start magnetization, one per cell.
+std::vector<Vec3> initial_iterate(OuterLoop& l, RelaxReport& report) {
+  l.backend.responsive_field(l.model, l.state, l.H_resp);
+  ++report.field_evaluations;
+  return fixed_plus_responsive(l);
+}
+
+std::vector<double> flatten(const std::vector<Vec3>& h) {
+  std::vector<double> x(3 * h.size());
+  for (size_t i = 0; i < h.size(); ++i)
+    for (int a = 0; a < 3; ++a) x[3 * i + a] = h[i][a];
+  return x;
+}
+
+// Per-component weights of the Anderson norm: one over each cell's field
+// scale at the initial iterate h (plus the floor).
+std::vector<double> cell_weights(const OuterLoop& l, const std::vector<Vec3>& h) {
+  const double floor = field_scale_floor(l, h);
+  std::vector<double> weights(3 * h.size());
+  for (size_t i = 0; i < h.size(); ++i) {
+    const double w = 1.0 / (cell_field_scale(l.model, l.state, l.cells[i], h[i]) + floor);
+    weights[3 * i] = weights[3 * i + 1] = weights[3 * i + 2] = w;
+  }
+  return weights;
+}
+
+// G(x): relaxes every cell under the applied field x, then evaluates the
+// responsive field.
+std::vector<Vec3> apply_map(OuterLoop& l, const std::vector<double>& x, RelaxReport& report) {
+  const int n = static_cast<int>(l.cells.size());
+  for (int i = 0; i < n; ++i) l.H_A[l.cells[i]] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+  // Inexact inner solves: each cell only as accurately as the outer loop
+  // can use now (1% of its last residual), down to the inner tolerance.
+  if (!report.residual_history.empty())
+    l.local.tolerance =
+        std::max(l.o.local.tolerance, std::min(1e-6, 1e-2 * report.residual_history.back()));
+  const LocalStats s = l.backend.relax_cells(l.model, l.state, l.H_A, l.local);
+  report.llg_steps += s.llg_steps;
+  report.newton_steps += s.newton_steps;
+  l.backend.responsive_field(l.model, l.state, l.H_resp);
+  ++report.field_evaluations;
+  return fixed_plus_responsive(l);
+}
+
+// Residual: change of each cell's applied field against its field scale.
+// Sets f = G(x) - x (flattened) and returns the largest relative change.
+double iterate_residual(const OuterLoop& l, const std::vector<Vec3>& G, std::vector<double>& f) {
+  double worst = 0.0;
+  const double fl = field_scale_floor(l, G);
+  for (size_t i = 0; i < G.size(); ++i) {
+    const int c = l.cells[i];
+    const Vec3 d = G[i] - l.H_A[c];
+    for (int a = 0; a < 3; ++a) f[3 * i + a] = d[a];
+    worst = std::max(worst, norm(d) / (cell_field_scale(l.model, l.state, c, G[i]) + fl));
+  }
+  return worst;
+}
+
+// Safeguarded Anderson step. Hysteretic cells make the map x -> G(x)
+// path-dependent: an extrapolated field that overshoots can switch cells
+// irreversibly (measured: a remanent nail demagnetized by one bad
+// iterate). So a step is capped at 30 times the residual (ill-conditioned
+// bodies such as needles need steps of ~1/(1 - lambda) = 100 times), and
+// when the residual grows past 10 times the best seen, the history is
+// dropped and a damped plain step taken instead.
+struct SafeguardedAnderson {
+  SafeguardedAnderson(int depth, double mixing, std::vector<double> w)
+      : mixer(depth, mixing), weights(std::move(w)) {
+    mixer.set_weights(weights);
+  }
+  AndersonMixer mixer;
+  std::vector<double> weights;
+  double best_residual = std::numeric_limits<double>::infinity();
+  int last_progress = 0;  // iteration of the last halving of the best residual
+};
+
+// Norm of v under the per-component weights.
+double weighted_norm(const std::vector<double>& weights, const std::vector<double>& v) {
+  double sum = 0.0;
+  for (size_t i = 0; i < v.size(); ++i) sum += weights[i] * weights[i] * v[i] * v[i];
+  return std::sqrt(sum);
+}
+
+// Stagnation (cells switching across a hysteresis jump make x -> G(x)
+// discontinuous, and the stored differences then describe the other
+// branch): if the best residual has not halved in 20 iterations, the
+// history is dropped.
+void drop_stagnant_history(SafeguardedAnderson& a, int iteration, double fw) {
+  if (fw < 0.5 * a.best_residual) {
+    a.last_progress = iteration;
+  } else if (iteration - a.last_progress >= 20) {
+    a.mixer.reset();
+    a.last_progress = iteration;
+  }
+}
+
+// The step cap: x - x_old at most kMaxStepPerResidual times the weighted
+// residual fw, in the weighted norm.
+void cap_step(const std::vector<double>& weights, const std::vector<double>& x_old, double fw,
+              std::vector<double>& x) {
+  std::vector<double> step(x.size());
+  for (size_t i = 0; i < x.size(); ++i) step[i] = x[i] - x_old[i];
+  const double dw = weighted_norm(weights, step);
+  if (dw > kMaxStepPerResidual * fw)
+    for (size_t i = 0; i < x.size(); ++i)
+      x[i] = x_old[i] + (kMaxStepPerResidual * fw / dw) * step[i];
+}
+
+// The next iterate x from the residual f at x (SafeguardedAnderson).
+void anderson_step(SafeguardedAnderson& a, int iteration, std::vector<double>& x,
+                   const std::vector<double>& f) {
+  const double fw = weighted_norm(a.weights, f);
+  if (fw > 10.0 * a.best_residual) {
+    a.mixer.reset();
+    for (size_t i = 0; i < x.size(); ++i) x[i] += 0.5 * f[i];
+    return;
+  }
+  drop_stagnant_history(a, iteration, fw);
+  a.best_residual = std::min(a.best_residual, fw);
+  const std::vector<double> x_old = x;
+  a.mixer.next(x, f);
+  cap_step(a.weights, x_old, fw, x);
+}
+
+// The two-level scheme's outer loop, Anderson-accelerated.
+RelaxReport relax_two_level(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
+                            MagneticBackend& backend, const std::vector<int>& cells,
+                            const std::vector<Vec3>& H_fixed) {
+  RelaxReport report;
+  OuterLoop l{model, state, backend, o, cells, H_fixed, o.local,
+              std::vector<Vec3>(model.cell_count()), std::vector<Vec3>(model.cell_count())};
+  l.local.single_step = false;
+  const std::vector<Vec3> h = initial_iterate(l, report);
+  std::vector<double> x = flatten(h), f(x.size());
+  SafeguardedAnderson anderson(o.anderson_depth, o.mixing, cell_weights(l, h));
+  for (report.iterations = 1; report.iterations <= o.max_iterations; ++report.iterations) {
+    const std::vector<Vec3> G = apply_map(l, x, report);
+    const double worst = iterate_residual(l, G, f);
+    report.residual = worst;
+    report.residual_history.push_back(worst);
+    if (worst <= o.tolerance) {
+      report.converged = true;
+      for (size_t i = 0; i < cells.size(); ++i) l.H_A[cells[i]] = G[i];
+      break;
+    }
+    anderson_step(anderson, report.iterations, x, f);
+  }
+  report.iterations = std::min(report.iterations, o.max_iterations);
+  for (int c : cells) state.applied_field[c] = l.H_A[c];
+  return report;
+}
+
+// The stages of a magnetic step, in order.
+
+// docs/architecture.md "One magnetic step", 0: skip_unchanged, nothing changed since.
+bool can_skip_step(const MagneticModel& model, const MagneticState& state, const RelaxOptions& o) {
+  return o.skip_unchanged && unchanged_since_last_solve(model, state, o);
+}
+
+RelaxReport skipped_report() {
+  RelaxReport skipped;
+  skipped.converged = skipped.skipped = true;
+  return skipped;
+}
+
+// docs/architecture.md "One magnetic step", 1: place the cells, begin the backend's step.
+void place_cells_and_begin_step(const MagneticModel& model, MagneticState& state,
+                                const RelaxOptions& o, MagneticBackend& backend) {
+  place_cells(model, state);
+  backend.set_far_field(o.far_field_theta);
+  backend.set_near_field(o.near_field, o.mutual_induction);
+  backend.begin_step(model, state);
+}
+
+// docs/architecture.md "One magnetic step", 2: H_E, fixed magnets and coils, once.
+std::vector<Vec3> fixed_field(const MagneticModel& model, const MagneticState& state,
+                              MagneticBackend& backend, const std::vector<int>& cells) {
+  if (cells.empty()) return {};
+  std::vector<Vec3> H_fixed(model.cell_count());
+  backend.fixed_field(model, state, H_fixed);
+  add_coil_fields(model, state, cells, H_fixed);
+  return H_fixed;
+}
+
+// docs/architecture.md "One magnetic step", 3: paper scheme, one pass or Anderson loop.
+RelaxReport solve(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
+                  MagneticBackend& backend, const std::vector<int>& cells,
+                  const std::vector<Vec3>& H_fixed) {
+  if (cells.empty()) {
+    RelaxReport nothing;
+    nothing.converged = true;
+    return nothing;
+  }
+  if (o.scheme == RelaxScheme::paper) return relax_paper(model, state, o, backend, cells, H_fixed);
+  if (!o.mutual_induction) return relax_one_pass(model, state, o, backend, cells, H_fixed);
+  return relax_two_level(model, state, o, backend, cells, H_fixed);
+}
+
+// docs/architecture.md "One magnetic step", 4: per-body forces and torques.
+void compute_forces(const MagneticModel& model, MagneticState& state, MagneticBackend& backend) {
   backend.forces(model, state);
+}
+
+// docs/architecture.md "One magnetic step", 5: remember what was solved, for the skip check.
+void record_step(MagneticState& state, const RelaxOptions& o, const RelaxReport& report) {
   // Only a run that skips pays for remembering what it solved.
-  if (options.skip_unchanged) {
-    record_solve(state, options, report.converged);
+  if (o.skip_unchanged) {
+    record_solve(state, o, report.converged);
   } else {
     state.last_solve.valid = false;
   }
+}
+
+}  // namespace
+
+RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
+                  MagneticBackend& backend) {
+  place_cells_and_begin_step(model, state, o, backend);
+  const std::vector<int> cells = active_responsive_cells(model, state);
+  const std::vector<Vec3> H_fixed = fixed_field(model, state, backend, cells);
+  return solve(model, state, o, backend, cells, H_fixed);
+}
+
+RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
+                          const RelaxOptions& options, MagneticBackend& backend) {
+  if (can_skip_step(model, state, options)) return skipped_report();
+  place_cells_and_begin_step(model, state, options, backend);
+  const std::vector<int> cells = active_responsive_cells(model, state);
+  const std::vector<Vec3> H_fixed = fixed_field(model, state, backend, cells);
+  RelaxReport report = solve(model, state, options, backend, cells, H_fixed);
+  compute_forces(model, state, backend);
+  record_step(state, options, report);
   return report;
 }
 

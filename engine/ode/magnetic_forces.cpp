@@ -1,5 +1,8 @@
 #include "engine/ode/magnetic_forces.h"
 
+#include <stdexcept>
+#include <utility>
+
 namespace odemag {
 
 BodyPose ode_pose(dBodyID body) {
@@ -16,6 +19,21 @@ MagneticForces::MagneticForces(const RelaxOptions& options, std::unique_ptr<Magn
                                uint64_t seed, IntraBodyTensor intra_tensor)
     : model_(intra_tensor), backend_(backend ? std::move(backend) : make_cpu_backend()), options_(options) {
   state_ = make_state(model_, seed);
+}
+
+MagneticForces::MagneticForces(MagneticModel model, MagneticState state, const RelaxOptions& options,
+                               std::unique_ptr<MagneticBackend> backend)
+    : model_(std::move(model)),
+      state_(std::move(state)),
+      bodies_(static_cast<size_t>(model_.body_count()), nullptr),
+      backend_(backend ? std::move(backend) : make_cpu_backend()),
+      options_(options) {}
+
+void MagneticForces::bind(int index, dBodyID body) {
+  if (index < 0 || index >= model_.body_count())
+    throw std::out_of_range("MagneticForces::bind: no magnetic body " + std::to_string(index));
+  bodies_[index] = body;
+  if (body) state_.pose[index] = ode_pose(body);
 }
 
 int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& material,

@@ -33,6 +33,14 @@ class MagneticForces : public ForceAccumulator {
                           std::unique_ptr<MagneticBackend> backend = nullptr, uint64_t seed = 1,
                           IntraBodyTensor intra_tensor = IntraBodyTensor::cell_average);
 
+  // Magnetics built elsewhere (a scene's, engine/sim/magnetic_scene.h): the
+  // model and its state as they are; bind() then ties bodies to ODE bodies.
+  MagneticForces(MagneticModel model, MagneticState state, const RelaxOptions& options,
+                 std::unique_ptr<MagneticBackend> backend);
+  // Ties magnetic body index to an ODE body (nullptr: static, set_pose) and
+  // takes its pose. Throws std::out_of_range on a bad index.
+  void bind(int index, dBodyID body);
+
   // Attaches a shape (centred on the body's centre of mass, in its frame) and
   // a material to an ODE body and returns the magnetic body index. body may be
   // nullptr for a static body placed with set_pose. cell_size <= 0: one cell.

@@ -64,21 +64,13 @@ BodyPose keyframe_pose(const std::vector<Keyframe>& keys, double t) {
 Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBackend> backend)
     : scene_(scene) {
   world_ = std::make_unique<RigidWorld>(scene_);
+  // The magnetic model of the scene, built as for solve and field
+  // (build_magnetic_scene), then tied to the ODE bodies.
+  MagneticScene ms = build_magnetic_scene(scene_);
   magnetics_ = std::make_unique<MagneticForces>(
-      scene_.solver.relax, backend ? std::move(backend) : make_cpu_backend(scene_.solver.threads),
-      scene_.seed);
-  for (size_t b = 0; b < scene_.bodies.size(); ++b) {
-    const BodyDescription& d = scene_.bodies[b];
-    const Material& material = scene_.materials.at(d.material);
-    try {
-      magnetics_->attach(world_->body(static_cast<int>(b)), d.shape, material,
-                         scene_.body_cell_size(static_cast<int>(b)), d.name);
-    } catch (const std::invalid_argument& e) {
-      throw SceneError(scene_.file, "bodies[" + std::to_string(b) + "]", e.what());
-    }
-    magnetics_->set_active(static_cast<int>(b), d.present);
-  }
-  magnetics_->set_external_field(scene_.external_field);
+      std::move(ms.model), std::move(ms.state), scene_.solver.relax,
+      backend ? std::move(backend) : make_cpu_backend(scene_.solver.threads));
+  for (size_t b = 0; b < scene_.bodies.size(); ++b) magnetics_->bind(static_cast<int>(b), world_->body(static_cast<int>(b)));
   world_->add_accumulator(magnetics_.get());
   for (size_t b = 0; b < scene_.bodies.size(); ++b) {
     const Vec3 half = shape_half_extents(scene_.bodies[b].shape);
