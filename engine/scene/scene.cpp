@@ -11,11 +11,14 @@
 #include <fstream>
 #include <functional>
 #include <initializer_list>
+#include <type_traits>
 #include <limits>
 #include <set>
 #include <sstream>
 #include <string_view>
 #include <utility>
+#include <variant>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -169,31 +172,10 @@ class SceneReader {
     if (!v.is_object()) fail(path, "must be an object {...}, got " + describe(v));
   }
 
-  // v must be an object whose keys are all in `allowed`.
-  void check_keys(const json& v, const std::string& path,
-                  std::initializer_list<std::string_view> allowed) const {
-    require_object(v, path);
-    for (const auto& [key, value] : v.items()) {
-      bool known = false;
-      for (std::string_view a : allowed) known = known || key == a;
-      if (known) continue;
-      std::string list;
-      for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-      fail(member(path, key), "unknown key (expected one of: " + list + ")");
-    }
-  }
-
   const json& required(const json& obj, std::string_view key, const std::string& path) const {
     const auto it = obj.find(key);
     if (it == obj.end()) fail(member(path, key), "required key is missing");
     return *it;
-  }
-
-  // Calls read(value, key_path) when obj has the key.
-  template <class Read>
-  void optional(const json& obj, std::string_view key, const std::string& path, Read&& read) const {
-    const auto it = obj.find(key);
-    if (it != obj.end()) read(*it, member(path, key));
   }
 
   double number(const json& v, const std::string& path) const {
@@ -260,7 +242,7 @@ class SceneReader {
   }
   // One of the given words.
   std::string choice(const json& v, const std::string& path,
-                     std::initializer_list<std::string_view> words) const {
+                     const std::vector<std::string_view>& words) const {
     const std::string s = string(v, path);
     std::string list;
     for (std::string_view w : words) {
@@ -326,6 +308,140 @@ class SceneReader {
   const std::string& file_;
 };
 
+// ---- the key tables -----------------------------------------------------------
+//
+// Every JSON object of a scene is read through a table with one KeyRule per
+// key: the table is the list of allowed keys (an unknown key is rejected with
+// the table's names, in table order), says how each present key is checked and
+// where its value goes, and carries the key's row of docs/scene-format.md
+// (scene_key_docs; tests/cli/scene_keys_test.cpp checks the docs against it).
+// Keys are read in table order, those marked `late` after the others.
+
+// Where a plain key's value is stored.
+using Slot = std::variant<double*, std::optional<double>*, int*, bool*, std::string*, Vec3*, Quaternion*,
+                          std::optional<std::array<double, 3>>*>;
+
+// How a plain key's value is checked; custom: the rule's own reader.
+enum class Check {
+  custom, number, positive, non_negative, in_range, integer, boolean, string, non_empty_string, choice,
+  vec3, non_zero_vec3, color, quaternion
+};
+
+// The key's row in docs/scene-format.md: type, unit, default ("" where the docs
+// leave the cell empty or the table has no such column).
+struct KeyDoc {
+  const char* type = "";
+  const char* unit = "";
+  const char* fallback = "";
+};
+
+template <class T>
+struct KeyRule {
+  const char* name;
+  Check check = Check::custom;
+  Slot (*slot)(T&) = nullptr;                                                        // plain keys
+  void (*read)(const SceneReader&, const json&, const std::string&, T&) = nullptr;  // Check::custom
+  double lo = 0.0, hi = 0.0;                  // in_range, integer
+  // choice: the words, then empty ones (a std::vector here crashes GCC 12).
+  std::array<std::string_view, 4> words{};
+  bool required = false;
+  // Read after the other keys: of several bad values the one reported first
+  // stays the one reported before the tables (solver.far_field_theta after
+  // near_field, an event's optional keyframes time after its keys).
+  bool late = false;
+  KeyDoc doc = {};
+};
+
+template <class T>
+using KeyTable = std::vector<KeyRule<T>>;
+
+// The slot of a plain key: SLOT(relax.tolerance).
+#define SLOT(field) [](auto& t) -> Slot { return &t.field; }
+
+// A key whose value its object's reader has read before the table (a material's
+// "type", an event's "action").
+constexpr auto kReadBefore = [](const SceneReader&, const json&, const std::string&, auto&) {};
+
+template <class V>
+void store(const Slot& slot, V value) {
+  std::visit(
+      [&](auto* target) {
+        using Target = std::remove_pointer_t<decltype(target)>;
+        if constexpr (std::is_same_v<Target, V> || std::is_same_v<Target, std::optional<V>>)
+          *target = std::move(value);
+        else
+          throw std::logic_error("scene key table: a slot of the wrong type");
+      },
+      slot);
+}
+
+// v must be an object whose keys are all in the table.
+template <class T>
+void check_unknown(const SceneReader& r, const json& v, const std::string& path,
+                   const KeyTable<T>& table) {
+  r.require_object(v, path);
+  for (const auto& [key, value] : v.items()) {
+    bool known = false;
+    for (const KeyRule<T>& rule : table) known = known || key == rule.name;
+    if (known) continue;
+    std::string list;
+    for (const KeyRule<T>& rule : table) list += (list.empty() ? "" : ", ") + std::string(rule.name);
+    r.fail(member(path, key), "unknown key (expected one of: " + list + ")");
+  }
+}
+
+template <class T>
+void read_value(const SceneReader& r, const KeyRule<T>& rule, const json& x, const std::string& p,
+                T& target) {
+  if (rule.check == Check::custom) return rule.read(r, x, p, target);
+  const Slot slot = rule.slot(target);
+  const auto lo = static_cast<int>(rule.lo), hi = static_cast<int>(rule.hi);
+  switch (rule.check) {
+    case Check::number: return store(slot, r.number(x, p));
+    case Check::positive: return store(slot, r.positive(x, p));
+    case Check::non_negative: return store(slot, r.non_negative(x, p));
+    case Check::in_range: return store(slot, r.in_range(x, p, rule.lo, rule.hi));
+    case Check::integer: return store(slot, r.int_value(x, p, lo, hi));
+    case Check::boolean: return store(slot, r.boolean(x, p));
+    case Check::string: return store(slot, r.string(x, p));
+    case Check::non_empty_string: return store(slot, r.non_empty_string(x, p));
+    case Check::choice: {
+      std::vector<std::string_view> words;
+      for (std::string_view w : rule.words)
+        if (!w.empty()) words.push_back(w);
+      return store(slot, r.choice(x, p, words));
+    }
+    case Check::vec3: return store(slot, r.vec3(x, p));
+    case Check::non_zero_vec3: return store(slot, r.non_zero_vec3(x, p));
+    case Check::color: return store(slot, r.color(x, p));
+    case Check::quaternion: return store(slot, r.quaternion(x, p));
+    case Check::custom: break;
+  }
+}
+
+// Reads the keys of v that the table has (a missing required key fails).
+template <class T>
+void read_present(const SceneReader& r, const json& v, const std::string& path, const KeyTable<T>& table,
+                  T& target) {
+  for (const bool late : {false, true})
+    for (const KeyRule<T>& rule : table) {
+      if (rule.late != late) continue;
+      const auto it = v.find(rule.name);
+      if (it == v.end()) {
+        if (rule.required) r.fail(member(path, rule.name), "required key is missing");
+        continue;
+      }
+      read_value(r, rule, *it, member(path, rule.name), target);
+    }
+}
+
+template <class T>
+void read_object(const SceneReader& r, const json& v, const std::string& path, const KeyTable<T>& table,
+                 T& target) {
+  check_unknown(r, v, path, table);
+  read_present(r, v, path, table, target);
+}
+
 // ---- materials ------------------------------------------------------------------
 
 // validate_material reports "KEY must ..."; name that key in the path.
@@ -337,53 +453,81 @@ std::string material_message_key(const std::string& message) {
   return {};
 }
 
+template <class M>
+struct MaterialTarget {
+  M material;
+  std::optional<std::array<double, 3>> color;
+};
+
+const KeyTable<MaterialTarget<PermanentMaterial>> kPermanentKeys = {
+    {.name = "type", .read = kReadBefore, .required = true, .doc = {"string", "", "**required**"}},
+    {.name = "magnetization", .check = Check::vec3, .slot = SLOT(material.magnetization), .required = true,
+     .doc = {"vector", "A/m", "**required**"}},
+    {.name = "recoil_susceptibility", .check = Check::non_negative, .slot = SLOT(material.recoil_susceptibility),
+     .doc = {"number", "", "`0`"}},
+    {.name = "color", .check = Check::color, .slot = SLOT(color),
+     .doc = {"[r, g, b]", "", "material default"}},
+};
+
+const KeyTable<MaterialTarget<SoftMaterial>> kSoftKeys = {
+    {.name = "type", .read = kReadBefore, .required = true, .doc = {"string", "", "**required**"}},
+    {.name = "saturation", .check = Check::positive, .slot = SLOT(material.saturation), .required = true,
+     .doc = {"number", "A/m", "**required**"}},
+    {.name = "susceptibility",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, MaterialTarget<SoftMaterial>& t) {
+       if (x.is_string()) {
+         if (x.get<std::string>() != "infinite") r.fail(p, "must be a number > 0 or the string \"infinite\"");
+         t.material.susceptibility = std::numeric_limits<double>::infinity();
+       } else {
+         t.material.susceptibility = r.positive(x, p);
+       }
+     },
+     .doc = {"number or `\"infinite\"`", "", "`\"infinite\"`"}},
+    {.name = "anisotropy_field", .check = Check::non_negative, .slot = SLOT(material.anisotropy_field),
+     .doc = {"number", "A/m", "`0`"}},
+    {.name = "easy_axis", .check = Check::non_zero_vec3, .slot = SLOT(material.easy_axis),
+     .doc = {"vector", "", "`[0, 0, 1]`"}},
+    {.name = "damping", .check = Check::positive, .slot = SLOT(material.damping),
+     .doc = {"number", "", "`1`"}},
+    {.name = "moments_per_cell",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, MaterialTarget<SoftMaterial>& t) {
+       const int n = r.int_value(x, p, 2, kMaxMomentsPerCell);
+       if (n % 2 != 0)
+         r.fail(p, "must be an even integer from 2 to " + std::to_string(kMaxMomentsPerCell) + ", got " +
+                       std::to_string(n));
+       t.material.moments_per_cell = n;
+     },
+     .doc = {"integer", "", "`2`"}},
+    {.name = "coil_field", .check = Check::vec3, .slot = SLOT(material.coil_field),
+     .doc = {"[x, y, z]", "A/m, body frame", "`[0, 0, 0]`"}},
+    {.name = "color", .check = Check::color, .slot = SLOT(color),
+     .doc = {"[r, g, b]", "", "material default"}},
+};
+
+const KeyTable<MaterialTarget<InertMaterial>> kInertKeys = {
+    {.name = "type", .read = kReadBefore, .required = true, .doc = {"string", "", "**required**"}},
+    {.name = "color", .check = Check::color, .slot = SLOT(color),
+     .doc = {"[r, g, b]", "", "material default"}},
+};
+
+template <class M>
+Material read_material_keys(const SceneReader& r, const json& v, const std::string& path,
+                            const KeyTable<MaterialTarget<M>>& table,
+                            std::optional<std::array<double, 3>>& color) {
+  MaterialTarget<M> t;
+  read_object(r, v, path, table, t);
+  color = t.color;
+  return t.material;
+}
+
 Material read_material(const SceneReader& r, const json& v, const std::string& path,
                        std::optional<std::array<double, 3>>& color) {
   r.require_object(v, path);
   const std::string type =
       r.choice(r.required(v, "type", path), member(path, "type"), {"permanent", "soft", "inert"});
-  Material material;
-  if (type == "permanent") {
-    r.check_keys(v, path, {"type", "magnetization", "recoil_susceptibility", "color"});
-    PermanentMaterial m;
-    m.magnetization = r.vec3(r.required(v, "magnetization", path), member(path, "magnetization"));
-    r.optional(v, "recoil_susceptibility", path,
-               [&](const json& x, const std::string& p) { m.recoil_susceptibility = r.non_negative(x, p); });
-    material = m;
-  } else if (type == "soft") {
-    r.check_keys(v, path, {"type", "saturation", "susceptibility", "anisotropy_field", "easy_axis",
-                           "damping", "moments_per_cell", "coil_field", "color"});
-    SoftMaterial m;
-    m.saturation = r.positive(r.required(v, "saturation", path), member(path, "saturation"));
-    r.optional(v, "susceptibility", path, [&](const json& x, const std::string& p) {
-      if (x.is_string()) {
-        if (x.get<std::string>() != "infinite")
-          r.fail(p, "must be a number > 0 or the string \"infinite\"");
-        m.susceptibility = std::numeric_limits<double>::infinity();
-      } else {
-        m.susceptibility = r.positive(x, p);
-      }
-    });
-    r.optional(v, "anisotropy_field", path,
-               [&](const json& x, const std::string& p) { m.anisotropy_field = r.non_negative(x, p); });
-    r.optional(v, "easy_axis", path,
-               [&](const json& x, const std::string& p) { m.easy_axis = r.non_zero_vec3(x, p); });
-    r.optional(v, "damping", path,
-               [&](const json& x, const std::string& p) { m.damping = r.positive(x, p); });
-    r.optional(v, "moments_per_cell", path, [&](const json& x, const std::string& p) {
-      const int n = r.int_value(x, p, 2, kMaxMomentsPerCell);
-      if (n % 2 != 0)
-        r.fail(p, "must be an even integer from 2 to " + std::to_string(kMaxMomentsPerCell) +
-                      ", got " + std::to_string(n));
-      m.moments_per_cell = n;
-    });
-    r.optional(v, "coil_field", path, [&](const json& x, const std::string& p) { m.coil_field = r.vec3(x, p); });
-    material = m;
-  } else {
-    r.check_keys(v, path, {"type", "color"});
-    material = InertMaterial{};
-  }
-  r.optional(v, "color", path, [&](const json& x, const std::string& p) { color = r.color(x, p); });
+  const Material material = type == "permanent" ? read_material_keys(r, v, path, kPermanentKeys, color)
+                            : type == "soft"    ? read_material_keys(r, v, path, kSoftKeys, color)
+                                                : read_material_keys(r, v, path, kInertKeys, color);
   // The physics checks of the magnetics library, as a backstop.
   if (const std::string e = validate_material(material); !e.empty())
     r.fail(member(path, material_message_key(e)), e);
@@ -398,58 +542,92 @@ Material read_material(const SceneReader& r, const json& v, const std::string& p
 // and events took seconds; docs/testing.md, fuzzing findings).
 using BodyIndex = std::map<std::string, size_t, std::less<>>;
 
+const KeyTable<Cylinder> kCylinderKeys = {
+    {.name = "radius", .check = Check::positive, .slot = SLOT(radius), .required = true},
+    {.name = "length", .check = Check::positive, .slot = SLOT(length), .required = true},
+};
+
+// Exactly one of these is present (read_shape).
+const KeyTable<Shape> kShapeKeys = {
+    {.name = "sphere",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, Shape& s) {
+       s = Sphere{r.positive(x, p)};
+     }},
+    {.name = "box",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, Shape& s) {
+       r.require_array(x, p, 3);
+       Box box;
+       for (size_t i = 0; i < 3; ++i) box.size[static_cast<int>(i)] = r.positive(x[i], element(p, i));
+       s = box;
+     }},
+    {.name = "cylinder",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, Shape& s) {
+       Cylinder c;
+       read_object(r, x, p, kCylinderKeys, c);
+       s = c;
+     }},
+};
+
 Shape read_shape(const SceneReader& r, const json& v, const std::string& path) {
-  r.check_keys(v, path, {"sphere", "box", "cylinder"});
+  check_unknown(r, v, path, kShapeKeys);
   if (v.size() != 1)
     r.fail(path, "must have exactly one of the keys sphere, box, cylinder (it has " +
                      std::to_string(v.size()) + ")");
-  const std::string kind = v.begin().key();
-  const json& value = v.begin().value();
-  const std::string p = member(path, kind);
   Shape shape;
-  if (kind == "sphere") {
-    shape = Sphere{r.positive(value, p)};
-  } else if (kind == "box") {
-    r.require_array(value, p, 3);
-    Box box;
-    for (size_t i = 0; i < 3; ++i) box.size[static_cast<int>(i)] = r.positive(value[i], element(p, i));
-    shape = box;
-  } else {
-    r.check_keys(value, p, {"radius", "length"});
-    Cylinder c;
-    c.radius = r.positive(r.required(value, "radius", p), member(p, "radius"));
-    c.length = r.positive(r.required(value, "length", p), member(p, "length"));
-    shape = c;
-  }
-  if (const std::string e = validate_shape(shape); !e.empty()) r.fail(p, e);
+  read_present(r, v, path, kShapeKeys, shape);
+  if (const std::string e = validate_shape(shape); !e.empty()) r.fail(member(path, v.begin().key()), e);
   return shape;
 }
 
+struct BodyTarget {
+  BodyDescription body;
+  const SceneDescription& scene;
+  const BodyIndex& index;
+};
+
+const KeyTable<BodyTarget> kBodyKeys = {
+    {.name = "name",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, BodyTarget& t) {
+       t.body.name = r.non_empty_string(x, p);
+       if (t.index.count(t.body.name)) r.fail(p, "another body is already named " + as_literal(t.body.name));
+     },
+     .required = true, .doc = {"string", "", "**required**"}},
+    {.name = "shape",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, BodyTarget& t) {
+       t.body.shape = read_shape(r, x, p);
+     },
+     .required = true, .doc = {"object", "m", "**required**"}},
+    {.name = "material",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, BodyTarget& t) {
+       t.body.material = r.string(x, p);
+       if (!t.scene.materials.count(t.body.material))
+         r.fail(p, "no material named " + as_literal(t.body.material) + " in materials");
+     },
+     .required = true, .doc = {"string", "", "**required**"}},
+    {.name = "position", .check = Check::vec3, .slot = SLOT(body.position),
+     .doc = {"vector", "m", "`[0, 0, 0]`"}},
+    {.name = "orientation", .check = Check::quaternion, .slot = SLOT(body.orientation),
+     .doc = {"[w, x, y, z]", "", "`[1, 0, 0, 0]`"}},
+    {.name = "velocity", .check = Check::vec3, .slot = SLOT(body.velocity),
+     .doc = {"vector", "m/s", "`[0, 0, 0]`"}},
+    {.name = "angular_velocity", .check = Check::vec3, .slot = SLOT(body.angular_velocity),
+     .doc = {"vector", "rad/s", "`[0, 0, 0]`"}},
+    {.name = "fixed", .check = Check::boolean, .slot = SLOT(body.fixed), .doc = {"bool", "", "`false`"}},
+    {.name = "density", .check = Check::positive, .slot = SLOT(body.density),
+     .doc = {"number", "kg/m^3", "`1000`"}},
+    {.name = "cell_size", .check = Check::non_negative, .slot = SLOT(body.cell_size),
+     .doc = {"number", "m", "see below"}},
+    {.name = "present", .check = Check::boolean, .slot = SLOT(body.present),
+     .doc = {"bool", "", "`true`"}},
+    {.name = "color", .check = Check::color, .slot = SLOT(body.color),
+     .doc = {"[r, g, b]", "", "material colour"}},
+};
+
 BodyDescription read_body(const SceneReader& r, const json& v, const std::string& path,
                           const SceneDescription& scene, const BodyIndex& index) {
-  r.check_keys(v, path, {"name", "shape", "material", "position", "orientation", "velocity",
-                         "angular_velocity", "fixed", "density", "cell_size", "present", "color"});
-  BodyDescription body;
-  body.name = r.non_empty_string(r.required(v, "name", path), member(path, "name"));
-  if (index.count(body.name))
-    r.fail(member(path, "name"), "another body is already named " + as_literal(body.name));
-  body.shape = read_shape(r, r.required(v, "shape", path), member(path, "shape"));
-  body.material = r.string(r.required(v, "material", path), member(path, "material"));
-  if (!scene.materials.count(body.material))
-    r.fail(member(path, "material"), "no material named " + as_literal(body.material) + " in materials");
-  r.optional(v, "position", path, [&](const json& x, const std::string& p) { body.position = r.vec3(x, p); });
-  r.optional(v, "orientation", path,
-             [&](const json& x, const std::string& p) { body.orientation = r.quaternion(x, p); });
-  r.optional(v, "velocity", path, [&](const json& x, const std::string& p) { body.velocity = r.vec3(x, p); });
-  r.optional(v, "angular_velocity", path,
-             [&](const json& x, const std::string& p) { body.angular_velocity = r.vec3(x, p); });
-  r.optional(v, "fixed", path, [&](const json& x, const std::string& p) { body.fixed = r.boolean(x, p); });
-  r.optional(v, "density", path, [&](const json& x, const std::string& p) { body.density = r.positive(x, p); });
-  r.optional(v, "cell_size", path,
-             [&](const json& x, const std::string& p) { body.cell_size = r.non_negative(x, p); });
-  r.optional(v, "present", path, [&](const json& x, const std::string& p) { body.present = r.boolean(x, p); });
-  r.optional(v, "color", path, [&](const json& x, const std::string& p) { body.color = r.color(x, p); });
-
+  BodyTarget t{{}, scene, index};
+  read_object(r, v, path, kBodyKeys, t);
+  BodyDescription& body = t.body;
 
   // The lattice must stay a sensible size.
   const double h = lattice_spacing(body, scene.cell_size);
@@ -470,91 +648,101 @@ BodyDescription read_body(const SceneReader& r, const json& v, const std::string
 
 // ---- settings ----------------------------------------------------------------------
 
-SolverSettings read_solver(const SceneReader& r, const json& v, const std::string& path) {
-  r.check_keys(v, path, {"scheme", "tolerance", "max_iterations", "anderson_depth", "mixing",
-                         "mutual_induction", "time_step_factor", "noise", "far_field_theta",
-                         "skip_unchanged", "near_field", "backend", "threads"});
-  SolverSettings s;
-  RelaxOptions& o = s.relax;
-  r.optional(v, "scheme", path, [&](const json& x, const std::string& p) {
-    o.scheme = r.choice(x, p, {"two_level", "paper"}) == "paper" ? RelaxScheme::paper : RelaxScheme::two_level;
-  });
-  r.optional(v, "tolerance", path, [&](const json& x, const std::string& p) { o.tolerance = r.positive(x, p); });
-  r.optional(v, "max_iterations", path, [&](const json& x, const std::string& p) {
-    o.max_iterations = r.int_value(x, p, 1, std::numeric_limits<int>::max());
-  });
-  r.optional(v, "anderson_depth", path,
-             [&](const json& x, const std::string& p) { o.anderson_depth = r.int_value(x, p, 0, 100); });
-  r.optional(v, "mixing", path, [&](const json& x, const std::string& p) { o.mixing = r.positive(x, p); });
-  r.optional(v, "mutual_induction", path,
-             [&](const json& x, const std::string& p) { o.mutual_induction = r.boolean(x, p); });
-  r.optional(v, "time_step_factor", path,
-             [&](const json& x, const std::string& p) { o.local.time_step_factor = r.positive(x, p); });
-  r.optional(v, "noise", path,
-             [&](const json& x, const std::string& p) { o.local.noise_ratio = r.non_negative(x, p); });
-  r.optional(v, "skip_unchanged", path,
-             [&](const json& x, const std::string& p) { o.skip_unchanged = r.boolean(x, p); });
-  r.optional(v, "near_field", path,
-             [&](const json& x, const std::string& p) { o.near_field = r.boolean(x, p); });
-  r.optional(v, "far_field_theta", path, [&](const json& x, const std::string& p) {
-    o.far_field_theta = r.in_range(x, p, 0.0, 0.9);
-  });
-  r.optional(v, "backend", path,
-             [&](const json& x, const std::string& p) { s.backend = r.choice(x, p, {"cpu", "cuda", "auto"}); });
-  r.optional(v, "threads", path, [&](const json& x, const std::string& p) {
-    s.threads = r.int_value(x, p, 0, 65536);
-  });
-  return s;
-}
+const KeyTable<SolverSettings> kSolverKeys = {
+    {.name = "scheme",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SolverSettings& s) {
+       const bool paper = r.choice(x, p, {"two_level", "paper"}) == "paper";
+       s.relax.scheme = paper ? RelaxScheme::paper : RelaxScheme::two_level;
+     },
+     .doc = {"string", "", "`\"two_level\"`"}},
+    {.name = "tolerance", .check = Check::positive, .slot = SLOT(relax.tolerance),
+     .doc = {"number", "", "`1e-6`"}},
+    {.name = "max_iterations", .check = Check::integer, .slot = SLOT(relax.max_iterations), .lo = 1,
+     .hi = std::numeric_limits<int>::max(), .doc = {"integer", "", "`200`"}},
+    {.name = "anderson_depth", .check = Check::integer, .slot = SLOT(relax.anderson_depth),
+     .lo = 0, .hi = 100,
+     .doc = {"integer", "", "`20`"}},
+    {.name = "mixing", .check = Check::positive, .slot = SLOT(relax.mixing),
+     .doc = {"number", "", "`1`"}},
+    {.name = "mutual_induction", .check = Check::boolean, .slot = SLOT(relax.mutual_induction),
+     .doc = {"bool", "", "`true`"}},
+    {.name = "time_step_factor", .check = Check::positive, .slot = SLOT(relax.local.time_step_factor),
+     .doc = {"number", "", "`0.5`"}},
+    {.name = "noise", .check = Check::non_negative, .slot = SLOT(relax.local.noise_ratio),
+     .doc = {"number", "", "`1e-6`"}},
+    {.name = "far_field_theta", .check = Check::in_range, .slot = SLOT(relax.far_field_theta), .lo = 0.0,
+     .hi = 0.9, .late = true, .doc = {"number", "", "`0`"}},
+    {.name = "skip_unchanged", .check = Check::boolean, .slot = SLOT(relax.skip_unchanged),
+     .doc = {"bool", "", "`false`"}},
+    {.name = "near_field", .check = Check::boolean, .slot = SLOT(relax.near_field),
+     .doc = {"bool", "", "`true`"}},
+    {.name = "backend", .check = Check::choice, .slot = SLOT(backend), .words = {"cpu", "cuda", "auto"},
+     .late = true, .doc = {"string", "", "`\"auto\"`"}},
+    {.name = "threads", .check = Check::integer, .slot = SLOT(threads),
+     .lo = 0, .hi = 65536, .late = true,
+     .doc = {"integer", "", "`0`"}},
+};
 
-SimulationSettings read_simulation(const SceneReader& r, const json& v, const std::string& path) {
-  r.check_keys(v, path, {"time_step", "duration", "frame_rate", "contact_solver", "solver_iterations", "ground",
-                         "ground_height", "contact", "linear_damping", "angular_damping",
-                         "max_substeps", "stiffness_limit"});
-  SimulationSettings s;
-  r.optional(v, "time_step", path, [&](const json& x, const std::string& p) { s.time_step = r.positive(x, p); });
-  r.optional(v, "duration", path, [&](const json& x, const std::string& p) { s.duration = r.non_negative(x, p); });
-  r.optional(v, "frame_rate", path, [&](const json& x, const std::string& p) { s.frame_rate = r.positive(x, p); });
-  r.optional(v, "contact_solver", path, [&](const json& x, const std::string& p) {
-    s.contact_solver = r.choice(x, p, {"auto", "quick", "exact"});
-  });
-  r.optional(v, "solver_iterations", path, [&](const json& x, const std::string& p) {
-    s.solver_iterations = r.int_value(x, p, 1, 1000000);
-  });
-  r.optional(v, "ground", path, [&](const json& x, const std::string& p) { s.ground = r.boolean(x, p); });
-  r.optional(v, "ground_height", path,
-             [&](const json& x, const std::string& p) { s.ground_height = r.number(x, p); });
-  r.optional(v, "contact", path, [&](const json& c, const std::string& cp) {
-    r.check_keys(c, cp, {"friction", "restitution", "softness", "erp", "rolling_friction"});
-    ContactSettings& k = s.contact;
-    r.optional(c, "friction", cp, [&](const json& x, const std::string& p) { k.friction = r.non_negative(x, p); });
-    r.optional(c, "restitution", cp,
-               [&](const json& x, const std::string& p) { k.restitution = r.in_range(x, p, 0.0, 1.0); });
-    r.optional(c, "softness", cp, [&](const json& x, const std::string& p) { k.softness = r.non_negative(x, p); });
-    r.optional(c, "erp", cp, [&](const json& x, const std::string& p) { k.erp = r.in_range(x, p, 0.0, 1.0); });
-    r.optional(c, "rolling_friction", cp,
-               [&](const json& x, const std::string& p) { k.rolling_friction = r.non_negative(x, p); });
-  });
-  r.optional(v, "linear_damping", path,
-             [&](const json& x, const std::string& p) { s.linear_damping = r.non_negative(x, p); });
-  r.optional(v, "angular_damping", path,
-             [&](const json& x, const std::string& p) { s.angular_damping = r.non_negative(x, p); });
-  r.optional(v, "max_substeps", path,
-             [&](const json& x, const std::string& p) { s.max_substeps = r.int_value(x, p, 1, 100000); });
-  r.optional(v, "stiffness_limit", path,
-             [&](const json& x, const std::string& p) { s.stiffness_limit = r.positive(x, p); });
-  return s;
-}
+const KeyTable<ContactSettings> kContactKeys = {
+    {.name = "friction", .check = Check::non_negative, .slot = SLOT(friction),
+     .doc = {"number", "", "`0.5`"}},
+    {.name = "restitution", .check = Check::in_range, .slot = SLOT(restitution), .lo = 0.0, .hi = 1.0,
+     .doc = {"number", "", "`0.1`"}},
+    {.name = "softness", .check = Check::non_negative, .slot = SLOT(softness),
+     .doc = {"number", "", "`1e-5`"}},
+    {.name = "erp", .check = Check::in_range, .slot = SLOT(erp), .lo = 0.0, .hi = 1.0,
+     .doc = {"number", "", "`0.2`"}},
+    {.name = "rolling_friction", .check = Check::non_negative, .slot = SLOT(rolling_friction),
+     .doc = {"number", "m", "`1e-5`"}},
+};
+
+const KeyTable<SimulationSettings> kSimulationKeys = {
+    {.name = "time_step", .check = Check::positive, .slot = SLOT(time_step),
+     .doc = {"number", "s", "`0.004`"}},
+    {.name = "duration", .check = Check::non_negative, .slot = SLOT(duration),
+     .doc = {"number", "s", "`2`"}},
+    {.name = "frame_rate", .check = Check::positive, .slot = SLOT(frame_rate),
+     .doc = {"number", "1/s", "`30`"}},
+    {.name = "contact_solver", .check = Check::choice, .slot = SLOT(contact_solver),
+     .words = {"auto", "quick", "exact"}, .doc = {"string", "", "`\"auto\"`"}},
+    {.name = "solver_iterations", .check = Check::integer, .slot = SLOT(solver_iterations), .lo = 1,
+     .hi = 1000000, .doc = {"integer", "", "`30`"}},
+    {.name = "ground", .check = Check::boolean, .slot = SLOT(ground), .doc = {"bool", "", "`true`"}},
+    {.name = "ground_height", .check = Check::number, .slot = SLOT(ground_height),
+     .doc = {"number", "m", "`0`"}},
+    {.name = "contact",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SimulationSettings& s) {
+       read_object(r, x, p, kContactKeys, s.contact);
+     },
+     .doc = {"object", "", ""}},
+    {.name = "linear_damping", .check = Check::non_negative, .slot = SLOT(linear_damping),
+     .doc = {"number", "", "`0`"}},
+    {.name = "angular_damping", .check = Check::non_negative, .slot = SLOT(angular_damping),
+     .doc = {"number", "", "`0`"}},
+    {.name = "max_substeps", .check = Check::integer, .slot = SLOT(max_substeps), .lo = 1, .hi = 100000,
+     .doc = {"integer", "", "`64`"}},
+    {.name = "stiffness_limit", .check = Check::positive, .slot = SLOT(stiffness_limit),
+     .doc = {"number", "", "`1`"}},
+};
+
+const KeyTable<CameraSettings> kCameraKeys = {
+    {.name = "position", .check = Check::vec3, .slot = SLOT(position),
+     .doc = {"vector", "m", "`[0.3, -0.3, 0.2]`"}},
+    {.name = "target", .check = Check::vec3, .slot = SLOT(target),
+     .doc = {"vector", "m", "`[0, 0, 0.05]`"}},
+    {.name = "up", .check = Check::non_zero_vec3, .slot = SLOT(up),
+     .doc = {"vector", "", "`[0, 0, 1]`"}},
+    {.name = "fov", .check = Check::in_range, .slot = SLOT(fov_degrees), .lo = 1.0, .hi = 179.0,
+     .doc = {"number", "degrees", "`40`"}},
+    {.name = "width", .check = Check::integer, .slot = SLOT(width), .lo = 16, .hi = 8192,
+     .doc = {"integer", "pixels", "`640`"}},
+    {.name = "height", .check = Check::integer, .slot = SLOT(height), .lo = 16, .hi = 8192,
+     .doc = {"integer", "pixels", "`480`"}},
+};
 
 CameraSettings read_camera(const SceneReader& r, const json& v, const std::string& path) {
-  r.check_keys(v, path, {"position", "target", "up", "fov", "width", "height"});
   CameraSettings c;
-  r.optional(v, "position", path, [&](const json& x, const std::string& p) { c.position = r.vec3(x, p); });
-  r.optional(v, "target", path, [&](const json& x, const std::string& p) { c.target = r.vec3(x, p); });
-  r.optional(v, "up", path, [&](const json& x, const std::string& p) { c.up = r.non_zero_vec3(x, p); });
-  r.optional(v, "fov", path, [&](const json& x, const std::string& p) { c.fov_degrees = r.in_range(x, p, 1.0, 179.0); });
-  r.optional(v, "width", path, [&](const json& x, const std::string& p) { c.width = r.int_value(x, p, 16, 8192); });
-  r.optional(v, "height", path, [&](const json& x, const std::string& p) { c.height = r.int_value(x, p, 16, 8192); });
+  read_object(r, v, path, kCameraKeys, c);
   const Vec3 view = c.target - c.position;
   if (view.x == 0.0 && view.y == 0.0 && view.z == 0.0)
     r.fail(member(path, "target"), "must differ from camera.position");
@@ -567,188 +755,297 @@ CameraSettings read_camera(const SceneReader& r, const json& v, const std::strin
   return c;
 }
 
-RenderSettings read_render(const SceneReader& r, const json& v, const std::string& path) {
-  r.check_keys(v, path, {"field_lines", "field_line_count", "force_colors"});
-  RenderSettings s;
-  r.optional(v, "field_lines", path, [&](const json& x, const std::string& p) { s.field_lines = r.boolean(x, p); });
-  r.optional(v, "field_line_count", path, [&](const json& x, const std::string& p) {
-    s.field_line_count = r.int_value(x, p, 1, 100000);
-  });
-  r.optional(v, "force_colors", path, [&](const json& x, const std::string& p) { s.force_colors = r.boolean(x, p); });
-  return s;
-}
+const KeyTable<RenderSettings> kRenderKeys = {
+    {.name = "field_lines", .check = Check::boolean, .slot = SLOT(field_lines),
+     .doc = {"bool", "", "`false`"}},
+    {.name = "field_line_count", .check = Check::integer, .slot = SLOT(field_line_count),
+     .lo = 1, .hi = 100000,
+     .doc = {"integer", "", "`48`"}},
+    {.name = "force_colors", .check = Check::boolean, .slot = SLOT(force_colors),
+     .doc = {"bool", "", "`false`"}},
+};
 
 // ---- time line ---------------------------------------------------------------------
 
-// The existing body named by the event's "body".
-const BodyDescription& event_body(const SceneReader& r, const json& v, const std::string& path,
-                                  const SceneDescription& scene, const BodyIndex& index) {
-  const std::string p = member(path, "body");
-  const std::string name = r.string(r.required(v, "body", path), p);
-  const auto it = index.find(name);
-  if (it == index.end()) r.fail(p, "no body named " + as_literal(name));
-  return scene.bodies[it->second];
-}
+struct KeyframeTarget {
+  Keyframe key;
+  const Keyframe* previous;  // the key before, if any
+};
 
-double event_end_time(const SceneReader& r, const json& v, const std::string& path, double time) {
-  double end = time;
-  r.optional(v, "end_time", path, [&](const json& x, const std::string& p) {
-    end = r.number(x, p);
-    if (end < time) r.fail(p, "must be >= time (" + format_number(time) + "), got " + format_number(end));
-  });
-  return end;
-}
+const KeyTable<KeyframeTarget> kKeyframeKeys = {
+    {.name = "time",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, KeyframeTarget& t) {
+       t.key.time = r.non_negative(x, p);
+       if (t.previous && !(t.key.time > t.previous->time))
+         r.fail(p, "key times must increase (previous key: " + format_number(t.previous->time) + ")");
+     },
+     .required = true},
+    {.name = "position", .check = Check::vec3, .slot = SLOT(key.position)},
+    {.name = "orientation", .check = Check::quaternion, .slot = SLOT(key.orientation)},
+};
 
 std::vector<Keyframe> read_keys(const SceneReader& r, const json& v, const std::string& path,
                                 const BodyDescription& body) {
   if (!v.is_array() || v.empty()) r.fail(path, "must be a non-empty array of {time, position, orientation}");
   std::vector<Keyframe> keys;
   for (size_t k = 0; k < v.size(); ++k) {
-    const std::string kp = element(path, k);
-    r.check_keys(v[k], kp, {"time", "position", "orientation"});
-    Keyframe key;
-    key.time = r.non_negative(r.required(v[k], "time", kp), member(kp, "time"));
-    if (!keys.empty() && !(key.time > keys.back().time))
-      r.fail(member(kp, "time"), "key times must increase (previous key: " +
-                                     format_number(keys.back().time) + ")");
-    key.position = body.position;
-    key.orientation = body.orientation;
-    r.optional(v[k], "position", kp, [&](const json& x, const std::string& p) { key.position = r.vec3(x, p); });
-    r.optional(v[k], "orientation", kp,
-               [&](const json& x, const std::string& p) { key.orientation = r.quaternion(x, p); });
-    keys.push_back(key);
+    KeyframeTarget t{{0.0, body.position, body.orientation}, keys.empty() ? nullptr : &keys.back()};
+    read_object(r, v[k], element(path, k), kKeyframeKeys, t);
+    keys.push_back(t.key);
   }
   return keys;
 }
 
-TimelineEvent read_event(const SceneReader& r, const json& v, const std::string& path,
-                         const SceneDescription& scene, const BodyIndex& index) {
-  using Kind = TimelineEvent::Kind;
-  r.require_object(v, path);
-  const std::string action =
-      r.choice(r.required(v, "action", path), member(path, "action"),
-               {"add", "remove", "scale_magnetization", "mutual_induction", "external_field", "keyframes"});
+struct EventTarget {
   TimelineEvent e;
-  const auto read_time = [&] {
-    e.time = r.non_negative(r.required(v, "time", path), member(path, "time"));
-    e.end_time = e.time;
-  };
-  if (action == "add" || action == "remove") {
-    r.check_keys(v, path, {"time", "action", "body"});
-    e.kind = action == "add" ? Kind::add_body : Kind::remove_body;
-    read_time();
-    e.body = event_body(r, v, path, scene, index).name;
-  } else if (action == "scale_magnetization") {
-    r.check_keys(v, path, {"time", "action", "body", "to", "end_time"});
-    e.kind = Kind::scale_magnetization;
-    read_time();
-    const BodyDescription& body = event_body(r, v, path, scene, index);
-    e.body = body.name;
-    const Material& material = scene.materials.at(body.material);
-    const SoftMaterial* soft = std::get_if<SoftMaterial>(&material);
-    const bool electromagnet = soft && norm(soft->coil_field) > 0.0;
-    if (!std::holds_alternative<PermanentMaterial>(material) && !electromagnet)
-      r.fail(member(path, "body"), "body " + as_literal(e.body) +
-                                       " is neither a permanent magnet nor an electromagnet (material " +
-                                       as_literal(body.material) + ")");
-    e.value = r.number(r.required(v, "to", path), member(path, "to"));
-    e.end_time = event_end_time(r, v, path, e.time);
-  } else if (action == "mutual_induction") {
-    r.check_keys(v, path, {"time", "action", "enabled"});
-    e.kind = Kind::mutual_induction;
-    read_time();
-    e.enabled = r.boolean(r.required(v, "enabled", path), member(path, "enabled"));
-  } else if (action == "external_field") {
-    r.check_keys(v, path, {"time", "action", "field", "end_time"});
-    e.kind = Kind::external_field;
-    read_time();
-    e.field = r.vec3(r.required(v, "field", path), member(path, "field"));
-    e.end_time = event_end_time(r, v, path, e.time);
-  } else {
-    r.check_keys(v, path, {"time", "action", "body", "keys"});
-    e.kind = Kind::keyframes;
-    const BodyDescription& body = event_body(r, v, path, scene, index);
-    e.body = body.name;
-    e.keys = read_keys(r, r.required(v, "keys", path), member(path, "keys"), body);
-    e.time = e.keys.front().time;
-    r.optional(v, "time", path, [&](const json& x, const std::string& p) { e.time = r.non_negative(x, p); });
-    e.end_time = std::max(e.time, e.keys.back().time);
-  }
-  return e;
+  const SceneDescription& scene;
+  const BodyIndex& index;
+  const BodyDescription* body = nullptr;  // the event's body, once read
+};
+
+// The existing body named by the event's "body".
+void read_event_body(const SceneReader& r, const json& x, const std::string& p, EventTarget& t) {
+  const std::string name = r.string(x, p);
+  const auto it = t.index.find(name);
+  if (it == t.index.end()) r.fail(p, "no body named " + as_literal(name));
+  t.body = &t.scene.bodies[it->second];
+  t.e.body = t.body->name;
 }
 
-OutcomeDescription read_outcome(const SceneReader& r, const json& v, const std::string& path) {
-  r.check_keys(v, path, {"name", "count_above", "time"});
-  OutcomeDescription o;
-  o.name = r.non_empty_string(r.required(v, "name", path), member(path, "name"));
-  const std::string cp = member(path, "count_above");
-  const json& c = r.required(v, "count_above", path);
-  r.check_keys(c, cp, {"prefix", "height"});
-  o.prefix = r.string(r.required(c, "prefix", cp), member(cp, "prefix"));
-  o.height = r.number(r.required(c, "height", cp), member(cp, "height"));
-  r.optional(v, "time", path, [&](const json& x, const std::string& p) { o.time = r.number(x, p); });
-  return o;
+const KeyRule<EventTarget> kEventTime = {
+    .name = "time",
+    .read = [](const SceneReader& r, const json& x, const std::string& p, EventTarget& t) {
+      t.e.time = r.non_negative(x, p);
+      t.e.end_time = t.e.time;
+    },
+    .required = true};
+const KeyRule<EventTarget> kEventAction = {.name = "action", .read = kReadBefore, .required = true};
+const KeyRule<EventTarget> kEventBody = {.name = "body", .read = read_event_body, .required = true};
+const KeyRule<EventTarget> kEventEndTime = {
+    .name = "end_time",
+    .read = [](const SceneReader& r, const json& x, const std::string& p, EventTarget& t) {
+      const double end = r.number(x, p);
+      if (end < t.e.time)
+        r.fail(p, "must be >= time (" + format_number(t.e.time) + "), got " + format_number(end));
+      t.e.end_time = end;
+    }};
+
+const KeyTable<EventTarget> kBodyEventKeys = {kEventTime, kEventAction, kEventBody};
+
+const KeyTable<EventTarget> kScaleEventKeys = {
+    kEventTime,
+    kEventAction,
+    {.name = "body",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, EventTarget& t) {
+       read_event_body(r, x, p, t);
+       const Material& material = t.scene.materials.at(t.body->material);
+       const SoftMaterial* soft = std::get_if<SoftMaterial>(&material);
+       const bool electromagnet = soft && norm(soft->coil_field) > 0.0;
+       if (!std::holds_alternative<PermanentMaterial>(material) && !electromagnet)
+         r.fail(p, "body " + as_literal(t.e.body) + " is neither a permanent magnet nor an electromagnet (material " +
+                       as_literal(t.body->material) + ")");
+     },
+     .required = true},
+    {.name = "to", .check = Check::number, .slot = SLOT(e.value), .required = true},
+    kEventEndTime,
+};
+
+const KeyTable<EventTarget> kInductionEventKeys = {
+    kEventTime, kEventAction,
+    {.name = "enabled", .check = Check::boolean, .slot = SLOT(e.enabled), .required = true}};
+
+const KeyTable<EventTarget> kFieldEventKeys = {
+    kEventTime, kEventAction, {.name = "field", .check = Check::vec3, .slot = SLOT(e.field), .required = true},
+    kEventEndTime};
+
+const KeyTable<EventTarget> kKeyframesEventKeys = {
+    // Optional here, read after the keys: it defaults to the first key's time.
+    {.name = "time",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, EventTarget& t) {
+       t.e.time = r.non_negative(x, p);
+     },
+     .late = true},
+    kEventAction,
+    kEventBody,
+    {.name = "keys",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, EventTarget& t) {
+       t.e.keys = read_keys(r, x, p, *t.body);
+       t.e.time = t.e.keys.front().time;
+     },
+     .required = true},
+};
+
+struct EventAction {
+  const char* action;
+  TimelineEvent::Kind kind;
+  const KeyTable<EventTarget>* keys;
+};
+
+const std::vector<EventAction> kEventActions = {
+    {"add", TimelineEvent::Kind::add_body, &kBodyEventKeys},
+    {"remove", TimelineEvent::Kind::remove_body, &kBodyEventKeys},
+    {"scale_magnetization", TimelineEvent::Kind::scale_magnetization, &kScaleEventKeys},
+    {"mutual_induction", TimelineEvent::Kind::mutual_induction, &kInductionEventKeys},
+    {"external_field", TimelineEvent::Kind::external_field, &kFieldEventKeys},
+    {"keyframes", TimelineEvent::Kind::keyframes, &kKeyframesEventKeys},
+};
+
+TimelineEvent read_event(const SceneReader& r, const json& v, const std::string& path,
+                         const SceneDescription& scene, const BodyIndex& index) {
+  r.require_object(v, path);
+  std::vector<std::string_view> actions;
+  for (const EventAction& a : kEventActions) actions.push_back(a.action);
+  const std::string action = r.choice(r.required(v, "action", path), member(path, "action"), actions);
+  EventTarget t{{}, scene, index};
+  for (const EventAction& a : kEventActions)
+    if (action == a.action) {
+      t.e.kind = a.kind;
+      read_object(r, v, path, *a.keys, t);
+    }
+  if (t.e.kind == TimelineEvent::Kind::keyframes) t.e.end_time = std::max(t.e.time, t.e.keys.back().time);
+  return t.e;
 }
+
+const KeyTable<OutcomeDescription> kCountAboveKeys = {
+    {.name = "prefix", .check = Check::string, .slot = SLOT(prefix), .required = true},
+    {.name = "height", .check = Check::number, .slot = SLOT(height), .required = true},
+};
+
+const KeyTable<OutcomeDescription> kOutcomeKeys = {
+    {.name = "name", .check = Check::non_empty_string, .slot = SLOT(name), .required = true,
+     .doc = {"string", "", "**required**"}},
+    {.name = "count_above",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, OutcomeDescription& o) {
+       read_object(r, x, p, kCountAboveKeys, o);
+     },
+     .required = true, .doc = {"object", "", "**required**"}},
+    {.name = "time", .check = Check::number, .slot = SLOT(time), .doc = {"number", "", "`-1`"}},
+};
 
 // ---- the whole file --------------------------------------------------------------
 
-SceneDescription read_scene(const SceneReader& r, const json& root) {
+struct SceneTarget {
   SceneDescription scene;
-  scene.file = r.file();
-  r.check_keys(root, "", {"title", "gravity", "external_field", "cell_size", "seed", "materials",
-                          "bodies", "solver", "simulation", "timeline", "camera", "render", "outcomes"});
-  r.optional(root, "title", "", [&](const json& x, const std::string& p) { scene.title = r.string(x, p); });
-  r.optional(root, "gravity", "", [&](const json& x, const std::string& p) { scene.gravity = r.vec3(x, p); });
-  r.optional(root, "external_field", "",
-             [&](const json& x, const std::string& p) { scene.external_field = r.vec3(x, p); });
-  r.optional(root, "cell_size", "", [&](const json& x, const std::string& p) { scene.cell_size = r.non_negative(x, p); });
-  r.optional(root, "seed", "", [&](const json& x, const std::string& p) {
-    if (!x.is_number_unsigned() && !(x.is_number_integer() && x.get<long long>() >= 0))
-      r.fail(p, "must be a non-negative integer");
-    scene.seed = x.get<uint64_t>();
-  });
-
-  const json& materials = r.required(root, "materials", "");
-  r.require_object(materials, "materials");
-  for (const auto& [name, value] : materials.items()) {
-    const std::string p = member("materials", name);
-    if (name.empty()) r.fail(p, "a material name must not be empty");
-    std::optional<std::array<double, 3>> color;
-    scene.materials.emplace(name, read_material(r, value, p, color));
-    if (color) scene.material_colors.emplace(name, *color);
-  }
-
-  const json& bodies = r.required(root, "bodies", "");
-  if (!bodies.is_array() || bodies.empty()) r.fail("bodies", "must be a non-empty array of bodies");
   BodyIndex index;
-  for (size_t b = 0; b < bodies.size(); ++b) {
-    scene.bodies.push_back(read_body(r, bodies[b], element("bodies", b), scene, index));
-    index.emplace(scene.bodies.back().name, b);
-  }
+};
 
-  r.optional(root, "solver", "", [&](const json& x, const std::string& p) { scene.solver = read_solver(r, x, p); });
-  r.optional(root, "simulation", "",
-             [&](const json& x, const std::string& p) { scene.simulation = read_simulation(r, x, p); });
-  r.optional(root, "timeline", "", [&](const json& x, const std::string& p) {
-    if (!x.is_array()) r.fail(p, "must be an array of events");
-    for (size_t i = 0; i < x.size(); ++i) scene.timeline.push_back(read_event(r, x[i], element(p, i), scene, index));
-  });
-  r.optional(root, "camera", "", [&](const json& x, const std::string& p) { scene.camera = read_camera(r, x, p); });
-  r.optional(root, "render", "", [&](const json& x, const std::string& p) { scene.render = read_render(r, x, p); });
-  r.optional(root, "outcomes", "", [&](const json& x, const std::string& p) {
-    if (!x.is_array()) r.fail(p, "must be an array of outcomes");
-    std::set<std::string> names;
-    for (size_t i = 0; i < x.size(); ++i) {
-      scene.outcomes.push_back(read_outcome(r, x[i], element(p, i)));
-      if (!names.insert(scene.outcomes.back().name).second)
-        r.fail(member(element(p, i), "name"), "another outcome is already named " +
-                                                  as_literal(scene.outcomes.back().name));
-    }
-  });
-  return scene;
+const KeyTable<SceneTarget> kSceneKeys = {
+    {.name = "title", .check = Check::string, .slot = SLOT(scene.title),
+     .doc = {"string", "", "`\"\"`"}},
+    {.name = "gravity", .check = Check::vec3, .slot = SLOT(scene.gravity),
+     .doc = {"vector", "m/s^2", "`[0, 0, -9.81]`"}},
+    {.name = "external_field", .check = Check::vec3, .slot = SLOT(scene.external_field),
+     .doc = {"vector", "A/m", "`[0, 0, 0]`"}},
+    {.name = "cell_size", .check = Check::non_negative, .slot = SLOT(scene.cell_size),
+     .doc = {"number", "m", "`0`"}},
+    {.name = "seed",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       if (!x.is_number_unsigned() && !(x.is_number_integer() && x.get<long long>() >= 0))
+         r.fail(p, "must be a non-negative integer");
+       t.scene.seed = x.get<uint64_t>();
+     },
+     .doc = {"integer", "", "`1`"}},
+    {.name = "materials",
+     .read = [](const SceneReader& r, const json& x, const std::string& path, SceneTarget& t) {
+       r.require_object(x, path);
+       for (const auto& [name, value] : x.items()) {
+         const std::string p = member(path, name);
+         if (name.empty()) r.fail(p, "a material name must not be empty");
+         std::optional<std::array<double, 3>> color;
+         t.scene.materials.emplace(name, read_material(r, value, p, color));
+         if (color) t.scene.material_colors.emplace(name, *color);
+       }
+     },
+     .required = true, .doc = {"object", "", "**required**"}},
+    {.name = "bodies",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       if (!x.is_array() || x.empty()) r.fail(p, "must be a non-empty array of bodies");
+       for (size_t b = 0; b < x.size(); ++b) {
+         t.scene.bodies.push_back(read_body(r, x[b], element(p, b), t.scene, t.index));
+         t.index.emplace(t.scene.bodies.back().name, b);
+       }
+     },
+     .required = true, .doc = {"array", "", "**required**"}},
+    {.name = "solver",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       read_object(r, x, p, kSolverKeys, t.scene.solver);
+     },
+     .doc = {"object", "", ""}},
+    {.name = "simulation",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       read_object(r, x, p, kSimulationKeys, t.scene.simulation);
+     },
+     .doc = {"object", "", ""}},
+    {.name = "timeline",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       if (!x.is_array()) r.fail(p, "must be an array of events");
+       for (size_t i = 0; i < x.size(); ++i)
+         t.scene.timeline.push_back(read_event(r, x[i], element(p, i), t.scene, t.index));
+     },
+     .doc = {"array", "", "`[]`"}},
+    {.name = "camera",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       t.scene.camera = read_camera(r, x, p);
+     },
+     .doc = {"object", "", ""}},
+    {.name = "render",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       read_object(r, x, p, kRenderKeys, t.scene.render);
+     },
+     .doc = {"object", "", ""}},
+    {.name = "outcomes",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       if (!x.is_array()) r.fail(p, "must be an array of outcomes");
+       std::set<std::string> names;
+       for (size_t i = 0; i < x.size(); ++i) {
+         OutcomeDescription o;
+         read_object(r, x[i], element(p, i), kOutcomeKeys, o);
+         t.scene.outcomes.push_back(o);
+         if (!names.insert(o.name).second)
+           r.fail(member(element(p, i), "name"), "another outcome is already named " + as_literal(o.name));
+       }
+     },
+     .doc = {"array", "", "`[]`"}},
+};
+
+#undef SLOT
+
+SceneDescription read_scene(const SceneReader& r, const json& root) {
+  SceneTarget t;
+  t.scene.file = r.file();
+  read_object(r, root, "", kSceneKeys, t);
+  return std::move(t.scene);
+}
+
+template <class T>
+void add_key_docs(std::vector<SceneKeyDoc>& docs, const std::string& section, const KeyTable<T>& table) {
+  for (const KeyRule<T>& rule : table)
+    docs.push_back({section, rule.name, rule.doc.type, rule.doc.unit, rule.doc.fallback, rule.required});
 }
 
 }  // namespace
+
+std::vector<SceneKeyDoc> scene_key_docs() {
+  std::vector<SceneKeyDoc> docs;
+  add_key_docs(docs, "", kSceneKeys);
+  add_key_docs(docs, "materials.permanent", kPermanentKeys);
+  add_key_docs(docs, "materials.soft", kSoftKeys);
+  add_key_docs(docs, "materials.inert", kInertKeys);
+  add_key_docs(docs, "bodies[]", kBodyKeys);
+  add_key_docs(docs, "bodies[].shape", kShapeKeys);
+  add_key_docs(docs, "bodies[].shape.cylinder", kCylinderKeys);
+  add_key_docs(docs, "solver", kSolverKeys);
+  add_key_docs(docs, "simulation", kSimulationKeys);
+  add_key_docs(docs, "simulation.contact", kContactKeys);
+  for (const EventAction& a : kEventActions)
+    add_key_docs(docs, std::string("timeline[].") + a.action, *a.keys);
+  add_key_docs(docs, "timeline[].keys[]", kKeyframeKeys);
+  add_key_docs(docs, "camera", kCameraKeys);
+  add_key_docs(docs, "render", kRenderKeys);
+  add_key_docs(docs, "outcomes[]", kOutcomeKeys);
+  add_key_docs(docs, "outcomes[].count_above", kCountAboveKeys);
+  return docs;
+}
 
 SceneDescription parse_scene(const std::string& json_text, const std::string& file) {
   PathTracker tracker(file);

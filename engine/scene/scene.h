@@ -168,6 +168,23 @@ struct SceneDescription {
 // otherwise one cell for a sphere and the scene's cell_size for the rest.
 double lattice_spacing(const BodyDescription& body, double scene_cell_size);
 
+// One key of a scene object as the loader reads it (engine/scene/scene.cpp reads
+// every object through a table with one rule per key) and as
+// docs/scene-format.md documents it; tests/cli/scene_keys_test.cpp checks the
+// docs' key tables against these.
+struct SceneKeyDoc {
+  std::string section;  // the object: "" (top level), "materials.soft", "bodies[]", "solver", "timeline[].add", ...
+  std::string key;
+  std::string type;           // the docs' type column ("vector", "number", ...); "" where undocumented
+  std::string unit;           // the docs' unit column; "" where empty or the table has none
+  std::string default_value;  // the docs' default column ("`0`", "**required**", ...)
+  bool required = false;
+};
+
+// Every key of every scene object, table by table, in the order the loader
+// reads them and lists them in "unknown key" messages.
+std::vector<SceneKeyDoc> scene_key_docs();
+
 // Reads and validates a scene file. Throws SceneError (bad content, unknown
 // key, wrong type, NaN, negative size, missing key, unknown material, ...).
 SceneDescription load_scene(const std::string& path);
