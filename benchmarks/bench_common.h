@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <string>
@@ -25,6 +26,30 @@ inline void restart_with_passive_omp(char** argv) {
     setenv("OMP_WAIT_POLICY", "passive", 1);
     execv("/proc/self/exe", argv);
   }
+}
+
+// The value of command-line option argv[i] (argv[i + 1], and i moves on to
+// it); when the option is last, says "<program>: <option> needs a value" and
+// exits with status 2.
+inline std::string option_value(int argc, char** argv, int& i, const char* program) {
+  if (i + 1 >= argc) {
+    std::fprintf(stderr, "%s: %s needs a value\n", program, argv[i]);
+    std::exit(2);
+  }
+  return argv[++i];
+}
+
+// Opens the CSV and the markdown report for writing; false (the reason on
+// stderr, for out_dir) when either cannot be opened.
+inline bool open_reports(const std::string& out_dir, const std::string& csv_path, const std::string& md_path,
+                         FILE*& csv, FILE*& md) {
+  csv = std::fopen(csv_path.c_str(), "w");
+  md = std::fopen(md_path.c_str(), "w");
+  if (!csv || !md) {
+    std::perror(out_dir.c_str());
+    return false;
+  }
+  return true;
 }
 
 // "a,b,c" -> {"a", "b", "c"}.

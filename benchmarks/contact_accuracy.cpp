@@ -15,7 +15,7 @@
 
 #include "magnetics/backend.h"
 #include "magnetics/relax.h"
-#include "tests/magnetics/contact_references.h"
+#include "tests/support/contact_references.h"
 
 using namespace odemag;
 

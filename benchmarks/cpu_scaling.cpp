@@ -234,13 +234,7 @@ int main(int argc, char** argv) {
   double budget = 6.0, ghz = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "cpu_scaling: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
+    auto next = [&] { return bench::option_value(argc, argv, i, "cpu_scaling"); };
     if (a == "--out") out_dir = next();
     else if (a == "--max-cells") max_cells = std::atoi(next().c_str());
     else if (a == "--budget") budget = std::atof(next().c_str());

@@ -153,12 +153,8 @@ int main(int argc, char** argv) {
     std::fclose(f);
   }
   const std::string csv_path = out_dir + "/far_field_scaling.csv", md_path = out_dir + "/far_field_scaling.md";
-  FILE* csv = std::fopen(csv_path.c_str(), "w");
-  FILE* md = std::fopen(md_path.c_str(), "w");
-  if (!csv || !md) {
-    std::perror(out_dir.c_str());
-    return 1;
-  }
+  FILE *csv, *md;
+  if (!bench::open_reports(out_dir, csv_path, md_path, csv, md)) return 1;
   std::fprintf(csv, "# %s, %d threads\ncells,theta,threads,field_ms,build_ms,near_pairs,far_interactions,"
                     "ns_per_pair_equivalent,rms_error,max_error\n",
                model, threads);

@@ -2,49 +2,18 @@
 // largest eigenvalue of the linear response map M -> H_intra(M) / gamma_D of
 // soft iron bodies (chi = 5000). Above 1 the body magnetizes itself in
 // patterns without any applied field. Output: CSV on stdout.
-#include <Eigen/Dense>
-#include <cmath>
 #include <cstdio>
 
 #include "magnetics/model.h"
+#include "tests/support/magnetic_checks.h"
 
 using namespace odemag;
 
-// H_i = sum_j F_ij V_j M_j with F symmetric: the lattice tensors, and for
-// bodies with boundary cells the boundary correction (self and uniform-mode
-// tensors, magnetics/model.cpp). The map is similar to W^1/2 F W^1/2 / gamma_D
-// (W = diag V), which is symmetric.
+// The corrected operator where the body has boundary cells
+// (tests/support/magnetic_checks.h).
 double largest_eigenvalue(IntraBodyTensor kind, const Shape& shape, double h, double chi) {
-  MagneticModel model(kind);
-  SoftMaterial iron;
-  iron.saturation = 1.7e6;
-  iron.susceptibility = chi;
-  model.add_body("body", shape, iron, h);
-  const MagneticBody& b = model.body(0);
-  const int n = b.cell_count();
-  auto mat = [](const double* t) {
-    Eigen::Matrix3d m;
-    m << t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5];
-    return m;
-  };
-  const bool corrected = !b.self_tensors.empty();
-  Eigen::Matrix3d Gpi = Eigen::Matrix3d::Zero(), Gbeta = Eigen::Matrix3d::Zero();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) Gpi(r, c) = b.uniform_inverse[0].m[r][c], Gbeta(r, c) = b.uniform_inverse[1].m[r][c];
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      Eigen::Matrix3d F = Eigen::Matrix3d::Zero();
-      if (i != j) F = mat(&b.offset_tensors[6u * b.offset_index(b.cells.lattice_index[i], b.cells.lattice_index[j])]);
-      if (corrected) {
-        if (i == j) F += mat(&b.self_tensors[6u * i]);
-        F += mat(&b.uniform_tensors[12u * i]) * Gpi * mat(&b.uniform_tensors[12u * j]) -
-             mat(&b.uniform_tensors[12u * i + 6]) * Gbeta * mat(&b.uniform_tensors[12u * j + 6]);
-      }
-      G.block<3, 3>(3 * i, 3 * j) = std::sqrt(b.cells.volumes[i] * b.cells.volumes[j]) / b.soft.gamma_D * F;
-    }
-  G = 0.5 * (G + G.transpose());
-  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  const MagneticModel model = test_support::soft_body_model(kind, shape, h, chi);
+  return test_support::largest_response_eigenvalue(model.body(0));
 }
 
 int main() {

@@ -39,7 +39,7 @@
 #include "magnetics/backend.h"
 #include "magnetics/constants.h"
 #include "magnetics/relax.h"
-#include "tests/magnetics/reference_fields.h"
+#include "tests/support/reference_fields.h"
 
 using namespace odemag;
 namespace ref = odemag::reference;

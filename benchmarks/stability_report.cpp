@@ -1,6 +1,6 @@
 // The stability suite as a report (issue 7; docs/hard-cases.md): runs every
 // hard case of tests/engine/stability_test.cpp (same scenes, from
-// tests/engine/stability_cases.h), longer where the test is kept short, and
+// tests/support/stability_cases.h), longer where the test is kept short, and
 // writes DIR/stability.csv and DIR/stability.md.
 //
 //   stability_report [--out DIR] [--crane-duration T] [--only SUBSTRING]
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/engine/stability_cases.h"
+#include "tests/support/stability_cases.h"
 
 #ifndef ODEMAG_SOURCE_DIR
 #define ODEMAG_SOURCE_DIR "."
@@ -242,7 +242,7 @@ int main(int argc, char** argv) {
     md << "# Stability suite results\n\n"
           "Written by `build/bin/stability_report --out benchmarks/results` "
           "(benchmarks/stability_report.cpp; "
-          "scenes in tests/engine/stability_cases.h, asserted on by "
+          "scenes in tests/support/stability_cases.h, asserted on by "
           "tests/engine/stability_test.cpp; "
           "discussion in docs/hard-cases.md). Every number is sampled at every substep. Columns: "
           "bodies / "

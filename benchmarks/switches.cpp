@@ -262,13 +262,7 @@ int main(int argc, char** argv) {
   double crane_start = 0.75, budget = 3.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "switches: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
+    auto next = [&] { return bench::option_value(argc, argv, i, "switches"); };
     if (a == "--out") out_dir = next();
     else if (a == "--threads") threads = std::atoi(next().c_str());
     else if (a == "--scenes") scene_list = next();
@@ -493,12 +487,8 @@ int main(int argc, char** argv) {
     return std::string(b);
   };
   const std::string csv_path = out_dir + "/switches.csv", md_path = out_dir + "/switches.md";
-  FILE* csv = std::fopen(csv_path.c_str(), "w");
-  FILE* md = std::fopen(md_path.c_str(), "w");
-  if (!csv || !md) {
-    std::perror(out_dir.c_str());
-    return 1;
-  }
+  FILE *csv, *md;
+  if (!bench::open_reports(out_dir, csv_path, md_path, csv, md)) return 1;
   std::fprintf(csv,
                "scene,switch,setting,kind,steps,cells,responsive_cells,ms_per_step_mean,ms_per_step_median,"
                "time_vs_default,iterations_mean,field_evaluations_mean,steps_not_converged,field_pct,local_pct,"

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "magnetics/relax.h"
+#include "tests/support/scene_builders.h"
 
 namespace odemag {
 namespace {
@@ -23,13 +24,7 @@ SceneDescription small_scene() {
   s.materials["steel"] = steel;
   s.materials["wood"] = InertMaterial{};
   auto add = [&](const std::string& name, const Shape& shape, const std::string& material, const Vec3& p) {
-    BodyDescription b;
-    b.name = name;
-    b.shape = shape;
-    b.material = material;
-    b.position = p;
-    b.fixed = true;
-    s.bodies.push_back(b);
+    s.bodies.push_back(test_support::body(name, shape, material, p, true, BodyDescription{}.density));
   };
   add("magnet", Box{{0.04, 0.01, 0.01}}, "magnet", {0, 0, 0.02});
   add("ball", Sphere{0.005}, "steel", {0.04, 0, 0.02});

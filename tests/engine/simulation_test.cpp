@@ -8,28 +8,14 @@
 #include <cmath>
 
 #include "magnetics/constants.h"
+#include "tests/support/scene_builders.h"
 
 namespace odemag {
 namespace {
 
-SoftMaterial steel() {
-  SoftMaterial m;
-  m.saturation = 1.6e6;
-  m.susceptibility = 1000.0;
-  return m;
-}
-
-BodyDescription body(const std::string& name, const Shape& shape, const std::string& material,
-                     const Vec3& position, bool fixed = false, double density = 7800.0) {
-  BodyDescription b;
-  b.name = name;
-  b.shape = shape;
-  b.material = material;
-  b.position = position;
-  b.fixed = fixed;
-  b.density = density;
-  return b;
-}
+using test_support::body;
+using test_support::steel;
+using test_support::weightless_scene;
 
 // A steel ball (R = 5 mm) released 24 mm above (and slightly beside) the
 // pole of a fixed spherical magnet (R = 8 mm) lying on the ground. The pole is
@@ -76,10 +62,7 @@ INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnet, ::testing::Values(0.001, 0.0
 // A magnet free to turn in a uniform field oscillates about it with the
 // small-angle period T = 2 pi sqrt(I / (mu0 m H)); the field pushes it nowhere.
 TEST(CompassNeedle, SmallAnglePeriodAndNoNetForce) {
-  SceneDescription s;
-  s.file = "compass";
-  s.gravity = {0, 0, 0};
-  s.simulation.ground = false;
+  SceneDescription s = weightless_scene("compass");
   const double M = 8e5, R = 0.005, density = 7500.0, H = 2e3, theta0 = 0.05;
   s.materials["magnet"] = PermanentMaterial{{M, 0, 0}, 0.0};
   BodyDescription needle = body("needle", Sphere{R}, "magnet", {0.1, -0.2, 0.3}, false, density);
@@ -115,10 +98,7 @@ TEST(CompassNeedle, SmallAnglePeriodAndNoNetForce) {
 // Two equal permanent balls released at rest attract; before they touch, the
 // total momentum stays zero to 1e-9 of either ball's momentum.
 TEST(TwoMagnets, AttractWithMomentumConserved) {
-  SceneDescription s;
-  s.file = "two_magnets";
-  s.gravity = {0, 0, 0};
-  s.simulation.ground = false;
+  SceneDescription s = weightless_scene("two_magnets");
   s.simulation.time_step = 0.001;
   s.materials["magnet"] = PermanentMaterial{{0, 0, 1e6}, 0.0};
   s.bodies.push_back(body("a", Sphere{0.004}, "magnet", {0, 0, 0}));
@@ -141,10 +121,7 @@ TEST(TwoMagnets, AttractWithMomentumConserved) {
 // Time-line events happen at their times: a removed body stops interacting;
 // a magnetization ramp reaches its end value.
 TEST(Timeline, RemovedBodyStopsInteractingAndRampReachesItsEnd) {
-  SceneDescription s;
-  s.file = "timeline";
-  s.gravity = {0, 0, 0};
-  s.simulation.ground = false;
+  SceneDescription s = weightless_scene("timeline");
   s.simulation.time_step = 0.001;
   s.materials["magnet"] = PermanentMaterial{{0, 0, 1e6}, 0.0};
   s.materials["steel"] = steel();

@@ -3,7 +3,7 @@
 // balls, external fields of 1e-3..1e7 A/m, susceptibilities up to 1e6 and
 // infinity, objects of 1 mm to 1 m, and the NaN guard. Scenes and
 // measurements are shared with benchmarks/stability_report.cpp
-// (tests/engine/stability_cases.h), which tabulates the same runs longer.
+// (tests/support/stability_cases.h), which tabulates the same runs longer.
 //
 // What every case must show (expect_stable):
 // - every pose, velocity, force, torque and moment stays finite;
@@ -27,7 +27,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "tests/engine/stability_cases.h"
+#include "tests/support/stability_cases.h"
 
 namespace odemag::stability {
 namespace {

@@ -24,6 +24,7 @@
 #include "magnetics/near_field.h"
 #include "magnetics/relax.h"
 #include "magnetics/rng.h"
+#include "tests/support/test_math.h"
 
 namespace odemag {
 namespace {
@@ -72,11 +73,7 @@ std::string str(const Vec3& v) {
                                        << "; allowed " << tolerance << " x " << scale;
 }
 
-Mat3 axis_rotation(const Vec3& axis, double angle) {
-  const Vec3 a = normalized(axis);
-  const double s = std::sin(angle / 2);
-  return rotation_from_quaternion(std::cos(angle / 2), s * a.x, s * a.y, s * a.z);
-}
+using test_support::axis_rotation;
 
 SoftMaterial iron(double chi = 5000.0) {
   SoftMaterial m;

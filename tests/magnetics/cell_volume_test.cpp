@@ -5,10 +5,9 @@
 // references: the continuum sphere's moment in a uniform field, the exact
 // multipole force between a linear sphere and a point dipole, and the Bessel
 // integral force between coaxial uniformly magnetized cylinders
-// (tests/magnetics/contact_references.h).
+// (tests/support/contact_references.h).
 #include <gtest/gtest.h>
 
-#include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -20,7 +19,8 @@
 #include "magnetics/model.h"
 #include "magnetics/relax.h"
 #include "magnetics/state.h"
-#include "tests/magnetics/contact_references.h"
+#include "tests/support/contact_references.h"
+#include "tests/support/magnetic_checks.h"
 
 namespace odemag {
 namespace {
@@ -297,37 +297,9 @@ TEST(CellVolume, LatticeBallNearADipoleConverges) {
 // gamma_D, assembled from the model's tensors, is below 1, for chi = infinity
 // (the limit with no margin) and a finite chi, on a ball and a cylinder.
 double largest_response_eigenvalue(const Shape& shape, double h, double chi) {
-  MagneticModel model;
-  SoftMaterial iron;
-  iron.saturation = 1.7e6;
-  iron.susceptibility = chi;
-  model.add_body("body", shape, iron, h);
-  const MagneticBody& b = model.body(0);
-  const int n = b.cell_count();
-  EXPECT_FALSE(b.self_tensors.empty());
-  auto mat = [](const double* t) {
-    Eigen::Matrix3d m;
-    m << t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5];
-    return m;
-  };
-  // H_i = sum_j F_ij V_j M_j with F symmetric; the map is similar to
-  // W^1/2 F W^1/2 / gamma_D (W = diag V).
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  Eigen::Matrix3d Gpi, Gbeta;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) Gpi(r, c) = b.uniform_inverse[0].m[r][c], Gbeta(r, c) = b.uniform_inverse[1].m[r][c];
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      Eigen::Matrix3d F = mat(&b.uniform_tensors[12u * i]) * Gpi * mat(&b.uniform_tensors[12u * j]) -
-                          mat(&b.uniform_tensors[12u * i + 6]) * Gbeta * mat(&b.uniform_tensors[12u * j + 6]);
-      if (i == j)
-        F += mat(&b.self_tensors[6u * i]);
-      else
-        F += mat(&b.offset_tensors[6u * b.offset_index(b.cells.lattice_index[i], b.cells.lattice_index[j])]);
-      G.block<3, 3>(3 * i, 3 * j) = std::sqrt(b.cells.volumes[i] * b.cells.volumes[j]) / b.soft.gamma_D * F;
-    }
-  G = 0.5 * (G + G.transpose());  // symmetric to rounding
-  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(G, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  const MagneticModel model = test_support::soft_body_model(IntraBodyTensor::cell_average, shape, h, chi);
+  EXPECT_FALSE(model.body(0).self_tensors.empty());
+  return test_support::largest_response_eigenvalue(model.body(0));
 }
 
 TEST(CellVolume, CorrectedOperatorKeepsSoftBodiesStable) {

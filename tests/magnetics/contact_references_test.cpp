@@ -1,4 +1,4 @@
-// Self-checks of the contact-force references (tests/magnetics/contact_references.h)
+// Self-checks of the contact-force references (tests/support/contact_references.h)
 // against limits, symmetries and independent second methods:
 //   (a) sphere next to a dipole: the known axial series, -grad U, the
 //       dipole-induced-dipole limit, Kelvin images for mu = inf;
@@ -16,8 +16,8 @@
 #include <limits>
 #include <vector>
 
-#include "tests/magnetics/contact_references.h"
-#include "tests/magnetics/reference_fields.h"
+#include "tests/support/contact_references.h"
+#include "tests/support/reference_fields.h"
 
 namespace odemag {
 namespace {

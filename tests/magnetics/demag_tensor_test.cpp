@@ -9,6 +9,7 @@
 
 #include "magnetics/kernels.h"
 #include "magnetics/model.h"
+#include "tests/support/magnetic_checks.h"
 
 namespace odemag {
 namespace {
@@ -79,11 +80,7 @@ TEST(CubeDemagTensor, CubeOfCubesHasDemagFactorOneThird) {
 // Largest eigenvalue of the linear response map M -> H_intra(M) / gamma_D of
 // a soft body: above 1 the body magnetizes itself without any applied field.
 double largest_response_eigenvalue(IntraBodyTensor kind, const Shape& shape, double h, double chi) {
-  MagneticModel model(kind);
-  SoftMaterial iron;
-  iron.saturation = 1.7e6;
-  iron.susceptibility = chi;
-  model.add_body("body", shape, iron, h);
+  const MagneticModel model = test_support::soft_body_model(kind, shape, h, chi);
   const MagneticBody& b = model.body(0);
   const int n = b.cell_count();
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(3 * n, 3 * n);

@@ -1,5 +1,5 @@
 // Fields and induced moments against independent analytic references
-// (tests/magnetics/reference_fields.h): the closed-form cuboid field checked
+// (tests/support/reference_fields.h): the closed-form cuboid field checked
 // against itself (far field, demag factor, quadrature, potential, Maxwell),
 // then odemag's one-cell spheres (permanent, soft, recoil) and lattice bodies
 // (permanent cuboids, soft sphere) against the references.
@@ -17,7 +17,7 @@
 #include "magnetics/model.h"
 #include "magnetics/relax.h"
 #include "magnetics/state.h"
-#include "reference_fields.h"
+#include "tests/support/reference_fields.h"
 
 namespace odemag {
 namespace {
@@ -386,6 +386,16 @@ struct SoftCase {
   double ratio;  // |H0| / (gamma_D Ms): < 1 below saturation
 };
 
+// Soft material of saturation Ms and susceptibility chi; gamma_D = 1/3 +
+// 1/chi of a sphere of it.
+SoftMaterial soft_material(double Ms, double chi) {
+  SoftMaterial mat;
+  mat.saturation = Ms;
+  mat.susceptibility = chi;
+  return mat;
+}
+double sphere_gamma_D(double chi) { return 1.0 / 3.0 + (std::isinf(chi) ? 0.0 : 1.0 / chi); }
+
 Vec3 soft_field_direction(int i) {
   const Vec3 d[] = {{1, 0, 0}, {0.3, -0.7, 0.2}, {-0.9, 0.1, 0.45}, {0.05, 0.6, -0.8}};
   return normalized(d[i % 4]);
@@ -397,10 +407,8 @@ TEST(SoftSphere, OneCellMomentMatchesLinearSphere) {
   int most_iterations = 0;
   int i = 0;
   for (double chi : {10.0, 1000.0, kInf}) {
-    SoftMaterial mat;
-    mat.saturation = Ms;
-    mat.susceptibility = chi;
-    const double gamma_D = 1.0 / 3.0 + (std::isinf(chi) ? 0.0 : 1.0 / chi);
+    const SoftMaterial mat = soft_material(Ms, chi);
+    const double gamma_D = sphere_gamma_D(chi);
     // |H0| from ~4 A/m to ~5e6 A/m.
     for (double ratio : {1e-5, 1e-3, 0.05, 0.3, 0.7, 0.95, 0.999, 1.001, 1.05, 1.5, 10.0}) {
       const Vec3 H0 = ratio * gamma_D * Ms * soft_field_direction(i++);
@@ -437,10 +445,8 @@ void paper_scheme_cases(double noise_ratio, double tolerance, double accuracy) {
   const double R = 0.01, Ms = 1.2e6;
   int i = 0;
   for (double chi : {10.0, 1000.0, kInf}) {
-    SoftMaterial mat;
-    mat.saturation = Ms;
-    mat.susceptibility = chi;
-    const double gamma_D = 1.0 / 3.0 + (std::isinf(chi) ? 0.0 : 1.0 / chi);
+    const SoftMaterial mat = soft_material(Ms, chi);
+    const double gamma_D = sphere_gamma_D(chi);
     std::printf("[odemag] paper scheme, noise %g, tolerance %g, chi %g: iterations (rel err) at |H0|/(gamma_D Ms) =",
                 noise_ratio, tolerance, chi);
     for (double ratio : {0.3, 0.6, 0.9, 1.5, 5.0}) {
@@ -491,9 +497,7 @@ TEST(SoftSphere, LatticeSphereApproachesContinuumMoment) {
   const double R = 0.01, Ms = 1.7e6;
   const Vec3 H0 = 1e4 * normalized(Vec3{0.3, -0.7, 0.2});  // M ~ 3e4 << Ms: linear regime
   for (double chi : {kInf, 1.0}) {
-    SoftMaterial mat;
-    mat.saturation = Ms;
-    mat.susceptibility = chi;
+    const SoftMaterial mat = soft_material(Ms, chi);
     const Vec3 m_ref = ref::soft_sphere_moment(R, chi, Ms, H0);
     for (double k : {2.0, 4.0, 8.0}) {
       Scene s;

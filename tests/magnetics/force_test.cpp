@@ -9,15 +9,12 @@
 #include "magnetics/backend.h"
 #include "magnetics/kernels.h"
 #include "magnetics/relax.h"
+#include "tests/support/magnetic_checks.h"
 
 namespace odemag {
 namespace {
 
-Mat3 axis_rotation(const Vec3& axis, double angle) {
-  const Vec3 a = normalized(axis);
-  const double s = std::sin(angle / 2);
-  return rotation_from_quaternion(std::cos(angle / 2), s * a.x, s * a.y, s * a.z);
-}
+using test_support::axis_rotation;
 
 struct TwoMagnets {
   MagneticModel model;
@@ -49,29 +46,13 @@ void check_gradient(TwoMagnets& sys) {
   sys.forces();
   const Vec3 F = sys.state.force[1], T = sys.state.torque[1];
   ASSERT_GT(norm(F), 0.0);
+  auto energy = [&] { return sys.energy(); };
   const double dx = 1e-7;
-  const BodyPose pose = sys.state.pose[1];
-  for (int a = 0; a < 3; ++a) {
-    Vec3 e;
-    e[a] = 1.0;
-    sys.state.pose[1].position = pose.position + dx * e;
-    const double up = sys.energy();
-    sys.state.pose[1].position = pose.position - dx * e;
-    const double down = sys.energy();
-    sys.state.pose[1] = pose;
-    EXPECT_NEAR(F[a], -(up - down) / (2 * dx), 1e-6 * norm(F)) << "force axis " << a;
-  }
+  const Vec3 dF = test_support::minus_position_gradient(sys.state.pose[1], energy, dx);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(F[a], dF[a], 1e-6 * norm(F)) << "force axis " << a;
   const double dtheta = 1e-6;
-  for (int a = 0; a < 3; ++a) {
-    Vec3 e;
-    e[a] = 1.0;
-    sys.state.pose[1].rotation = axis_rotation(e, dtheta) * pose.rotation;
-    const double up = sys.energy();
-    sys.state.pose[1].rotation = axis_rotation(e, -dtheta) * pose.rotation;
-    const double down = sys.energy();
-    sys.state.pose[1] = pose;
-    EXPECT_NEAR(T[a], -(up - down) / (2 * dtheta), 1e-6 * norm(T)) << "torque axis " << a;
-  }
+  const Vec3 dT = test_support::minus_rotation_gradient(sys.state.pose[1], energy, dtheta);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(T[a], dT[a], 1e-6 * norm(T)) << "torque axis " << a;
 }
 
 TEST(Forces, AreMinusEnergyGradientApart) {
@@ -108,18 +89,11 @@ TEST(Forces, ClosedSystemHasZeroNetForceAndBalancedTorque) {
   auto backend = make_cpu_backend(2);
   const RelaxReport r = magnetic_step(model, state, RelaxOptions{}, *backend);
   EXPECT_TRUE(r.converged);
-  Vec3 total_force, total_torque;
-  double scale_f = 0.0, scale_t = 0.0;
-  for (int b = 0; b < model.body_count(); ++b) {
-    total_force += state.force[b];
-    // Angular momentum balance about the origin: sum of x_b x F_b + tau_b.
-    total_torque += cross(state.pose[b].position, state.force[b]) + state.torque[b];
-    scale_f = std::max(scale_f, norm(state.force[b]));
-    scale_t = std::max(scale_t, norm(state.torque[b]) + norm(state.pose[b].position) * norm(state.force[b]));
-  }
-  ASSERT_GT(scale_f, 0.0);
-  EXPECT_LT(norm(total_force), 1e-12 * scale_f);
-  EXPECT_LT(norm(total_torque), 1e-12 * scale_t);
+  // Angular momentum balance about the origin: sum of x_b x F_b + tau_b.
+  const test_support::NetForceAndTorque net = test_support::net_force_and_torque(model, state);
+  ASSERT_GT(net.force_scale, 0.0);
+  EXPECT_LT(norm(net.force), 1e-12 * net.force_scale);
+  EXPECT_LT(norm(net.torque), 1e-12 * net.torque_scale);
 }
 
 TEST(Forces, UniformFieldGivesTorqueButNoForce) {

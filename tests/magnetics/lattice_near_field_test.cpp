@@ -20,17 +20,14 @@
 #include "magnetics/near_field.h"
 #include "magnetics/relax.h"
 #include "magnetics/state.h"
+#include "tests/support/magnetic_checks.h"
 
 namespace odemag {
 namespace {
 
 constexpr double kH = 1e-3;  // lattice spacing of every body below, m
 
-Mat3 axis_rotation(const Vec3& axis, double angle) {
-  const Vec3 a = normalized(axis);
-  const double s = std::sin(angle / 2);
-  return rotation_from_quaternion(std::cos(angle / 2), s * a.x, s * a.y, s * a.z);
-}
+using test_support::axis_rotation;
 
 // Linear soft iron: chi = 1000 with a saturation far above the fields used.
 SoftMaterial linear_iron() {
@@ -243,23 +240,8 @@ void wrenches(MagnetAndBlock& sys, int b, bool correction, double dx, double dth
     computed.force -= sys.state.force[b];
     computed.torque -= sys.state.torque[b];
   }
-  const BodyPose pose = sys.state.pose[b];
-  for (int a = 0; a < 3; ++a) {
-    Vec3 e;
-    e[a] = 1.0;
-    sys.state.pose[b].position = pose.position + dx * e;
-    const double up = energy();
-    sys.state.pose[b].position = pose.position - dx * e;
-    const double down = energy();
-    sys.state.pose[b] = pose;
-    differenced.force[a] = -(up - down) / (2 * dx);
-    sys.state.pose[b].rotation = axis_rotation(e, dtheta) * pose.rotation;
-    const double turned_up = energy();
-    sys.state.pose[b].rotation = axis_rotation(e, -dtheta) * pose.rotation;
-    const double turned_down = energy();
-    sys.state.pose[b] = pose;
-    differenced.torque[a] = -(turned_up - turned_down) / (2 * dtheta);
-  }
+  differenced.force = test_support::minus_position_gradient(sys.state.pose[b], energy, dx);
+  differenced.torque = test_support::minus_rotation_gradient(sys.state.pose[b], energy, dtheta);
 }
 
 // Steps 1e-4 h and 1e-6 rad: truncation and rounding ~1e-8 of the force.
@@ -342,19 +324,12 @@ TEST(LatticeNearField, ClosedSystemHasZeroNetForceAndBalancedTorque) {
   NearField nf;
   nf.build(model, state, true);
   ASSERT_GT(nf.pair_count(), 0);
-  Vec3 total_force, total_torque;
-  double scale_f = 0.0, scale_t = 0.0;
-  for (int b = 0; b < model.body_count(); ++b) {
-    total_force += state.force[b];
-    total_torque += cross(state.pose[b].position, state.force[b]) + state.torque[b];
-    scale_f = std::max(scale_f, norm(state.force[b]));
-    scale_t = std::max(scale_t, norm(state.torque[b]) + norm(state.pose[b].position) * norm(state.force[b]));
-  }
-  ASSERT_GT(scale_f, 0.0);
+  const test_support::NetForceAndTorque net = test_support::net_force_and_torque(model, state);
+  ASSERT_GT(net.force_scale, 0.0);
   std::printf("[lattice near field] closed system: %d pairs, net force %.1e, net torque %.1e of the largest\n",
-              nf.pair_count(), norm(total_force) / scale_f, norm(total_torque) / scale_t);
-  EXPECT_LT(norm(total_force), 1e-12 * scale_f);
-  EXPECT_LT(norm(total_torque), 1e-12 * scale_t);
+              nf.pair_count(), norm(net.force) / net.force_scale, norm(net.torque) / net.torque_scale);
+  EXPECT_LT(norm(net.force), 1e-12 * net.force_scale);
+  EXPECT_LT(norm(net.torque), 1e-12 * net.torque_scale);
 }
 
 // Aligned lattices get pairs; turned past the window (1 degree) none, and the

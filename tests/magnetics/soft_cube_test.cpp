@@ -1,5 +1,5 @@
 // A high-susceptibility soft cube on a lattice against the converged
-// boundary-element reference of tests/magnetics/contact_references.h (the
+// boundary-element reference of tests/support/contact_references.h (the
 // magnetometric demagnetizing factor N_m(chi), Richardson-extrapolated): the
 // mean magnetization in a uniform field, chi H0 / (1 + N_m chi).
 //
@@ -15,7 +15,7 @@
 
 #include "magnetics/backend.h"
 #include "magnetics/relax.h"
-#include "tests/magnetics/contact_references.h"
+#include "tests/support/contact_references.h"
 
 namespace odemag {
 namespace {

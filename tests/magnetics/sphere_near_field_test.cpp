@@ -1,7 +1,7 @@
 // Near field of one-cell spheres (magnetics/sphere_near_field.cpp,
 // docs/model.md "The near field"): forces between a one-cell soft ball and a
 // magnet ball, and between two one-cell soft balls in a uniform field,
-// against the exact linear solutions of tests/magnetics/contact_references.h
+// against the exact linear solutions of tests/support/contact_references.h
 // (written independently of the engine); continuity down to contact and
 // through overlap; F = -grad U; saturation; the switch.
 #include <gtest/gtest.h>
@@ -11,7 +11,8 @@
 
 #include "magnetics/backend.h"
 #include "magnetics/relax.h"
-#include "tests/magnetics/contact_references.h"
+#include "tests/support/contact_references.h"
+#include "tests/support/magnetic_checks.h"
 
 namespace odemag {
 namespace {
@@ -32,11 +33,7 @@ SoftMaterial linear_iron(double chi) {
   return s;
 }
 
-Mat3 axis_rotation(const Vec3& axis, double angle) {
-  const Vec3 a = normalized(axis);
-  const double s = std::sin(angle / 2);
-  return rotation_from_quaternion(std::cos(angle / 2), s * a.x, s * a.y, s * a.z);
-}
+using test_support::axis_rotation;
 
 struct Pair {
   MagneticModel model;
@@ -188,35 +185,20 @@ TEST(SphereNearField, ForcesAndTorquesAreMinusEnergyGradient) {
     p.backend->begin_step(p.model, p.state);
     p.backend->forces(p.model, p.state);
     const Vec3 F = p.state.force[body], T = p.state.torque[body];
-    const BodyPose pose = p.state.pose[body];
     auto energy = [&] {
       place_cells(p.model, p.state);
       return magnetic_energy(p.model, p.state);
     };
     const double dx = 1e-8;
-    for (int a = 0; a < 3; ++a) {
-      Vec3 e;
-      e[a] = 1.0;
-      p.state.pose[body].position = pose.position + dx * e;
-      const double up = energy();
-      p.state.pose[body].position = pose.position - dx * e;
-      const double down = energy();
-      p.state.pose[body] = pose;
-      EXPECT_NEAR(F[a], -(up - down) / (2 * dx), 1e-6 * norm(F)) << "body " << body << " force axis " << a;
-    }
+    const Vec3 dF = test_support::minus_position_gradient(p.state.pose[body], energy, dx);
+    for (int a = 0; a < 3; ++a)
+      EXPECT_NEAR(F[a], dF[a], 1e-6 * norm(F)) << "body " << body << " force axis " << a;
     const double dtheta = 1e-6;
     if (body != 0) continue;
     ASSERT_GT(norm(T), 0.0);
-    for (int a = 0; a < 3; ++a) {
-      Vec3 e;
-      e[a] = 1.0;
-      p.state.pose[body].rotation = axis_rotation(e, dtheta) * pose.rotation;
-      const double up = energy();
-      p.state.pose[body].rotation = axis_rotation(e, -dtheta) * pose.rotation;
-      const double down = energy();
-      p.state.pose[body] = pose;
-      EXPECT_NEAR(T[a], -(up - down) / (2 * dtheta), 1e-6 * norm(T)) << "body " << body << " torque axis " << a;
-    }
+    const Vec3 dT = test_support::minus_rotation_gradient(p.state.pose[body], energy, dtheta);
+    for (int a = 0; a < 3; ++a)
+      EXPECT_NEAR(T[a], dT[a], 1e-6 * norm(T)) << "body " << body << " torque axis " << a;
   }
 }
 

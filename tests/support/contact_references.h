@@ -853,28 +853,33 @@ inline CubeSystem cube_system(int n) {
     const int kk = k >= h ? k - h : n - 1 - k - h;
     return T + kk * h + j;
   };
-  // Class and sign of panel (p, q) of face f = 2 * axis + (side > 0); p runs
-  // along axis (axis+1)%3, q along (axis+2)%3.
+  // Calls g(axis, side, ua, va, p, q, id) for every panel (p, q) of every face
+  // f = 2 * axis + (side > 0), id = (f * n + p) * n + q; p runs along axis
+  // ua = (axis+1)%3, q along va = (axis+2)%3.
+  auto for_each_panel = [n](auto&& g) {
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = -1; side <= 1; side += 2) {
+        const int f = 2 * axis + (side > 0);
+        const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+        for (int p = 0; p < n; ++p)
+          for (int q = 0; q < n; ++q) g(axis, side, ua, va, p, q, (f * n + p) * n + q);
+      }
+  };
+  // Class and sign of each panel.
   std::vector<int> cls(6 * n * n), sgn(6 * n * n);
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = -1; side <= 1; side += 2) {
-      const int f = 2 * axis + (side > 0);
-      const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
-      for (int p = 0; p < n; ++p)
-        for (int q = 0; q < n; ++q) {
-          int idx[3] = {0, 0, 0};
-          idx[ua] = p;
-          idx[va] = q;
-          int c, sg = side;
-          if (axis == 2) {
-            c = top_index(idx[0], idx[1]);
-          } else {
-            c = side_index(axis == 0 ? idx[1] : idx[0], idx[2], sg);
-          }
-          cls[(f * n + p) * n + q] = c;
-          sgn[(f * n + p) * n + q] = sg;
-        }
+  for_each_panel([&](int axis, int side, int ua, int va, int p, int q, int id) {
+    int idx[3] = {0, 0, 0};
+    idx[ua] = p;
+    idx[va] = q;
+    int c, sg = side;
+    if (axis == 2) {
+      c = top_index(idx[0], idx[1]);
+    } else {
+      c = side_index(axis == 0 ? idx[1] : idx[0], idx[2], sg);
     }
+    cls[id] = c;
+    sgn[id] = sg;
+  });
   // Representatives: top (i <= j < h) on z = +1/2; side (j < h, k = h + kk) on x = +1/2.
   struct Rep {
     int axis;
@@ -942,20 +947,13 @@ inline CubeSystem cube_system(int n) {
           }
       }
   }
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side = -1; side <= 1; side += 2) {
-      const int f = 2 * axis + (side > 0);
-      const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
-      for (int p = 0; p < n; ++p)
-        for (int q = 0; q < n; ++q) {
-          double zc = 0.0;
-          if (axis == 2) zc = 0.5 * side;
-          else if (ua == 2) zc = 0.5 * (s[p] + s[p + 1]);
-          else if (va == 2) zc = 0.5 * (s[q] + s[q + 1]);
-          const int id = (f * n + p) * n + q;
-          sys.moment(cls[id]) += sgn[id] * zc * (s[p + 1] - s[p]) * (s[q + 1] - s[q]);
-        }
-    }
+  for_each_panel([&](int axis, int side, int ua, int va, int p, int q, int id) {
+    double zc = 0.0;
+    if (axis == 2) zc = 0.5 * side;
+    else if (ua == 2) zc = 0.5 * (s[p] + s[p + 1]);
+    else if (va == 2) zc = 0.5 * (s[q] + s[q + 1]);
+    sys.moment(cls[id]) += sgn[id] * zc * (s[p + 1] - s[p]) * (s[q + 1] - s[q]);
+  });
   return sys;
 }
 

@@ -24,6 +24,7 @@
 #include "magnetics/kernels.h"
 #include "magnetics/near_field.h"
 #include "magnetics/relax.h"
+#include "tests/support/scene_builders.h"
 
 namespace odemag::stability {
 
@@ -71,30 +72,14 @@ struct RunOptions {
   bool magnetic_energy = true;  // track the magnetic energy (when consistent, see below)
 };
 
-inline SoftMaterial steel() {
-  SoftMaterial m;
-  m.saturation = 1.6e6;
-  m.susceptibility = 1000.0;
-  return m;
-}
+using test_support::steel;  // tests/support/scene_builders.h
 
 // NdFeB: remanence about 1.3 T, M_r = 1.0e6 A/m.
 inline PermanentMaterial ndfeb(const Vec3& direction = {0, 0, 1}) {
   return PermanentMaterial{1.0e6 * normalized(direction), 0.0};
 }
 
-inline BodyDescription body(const std::string& name, const Shape& shape,
-                            const std::string& material, const Vec3& position, bool fixed = false,
-                            double density = 7800.0) {
-  BodyDescription b;
-  b.name = name;
-  b.shape = shape;
-  b.material = material;
-  b.position = position;
-  b.fixed = fixed;
-  b.density = density;
-  return b;
-}
+using test_support::body;
 
 inline SceneDescription empty_scene(const std::string& name, double time_step = 0.004) {
   SceneDescription s;

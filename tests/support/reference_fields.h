@@ -123,6 +123,20 @@ inline double y_log_z_plus_r(double X, double Y, double Z, double R) {
   return Y * std::log(z_plus_r(X, Y, Z, R));
 }
 
+// Calls f(s, X, Y, Z, R) at the 8 corners (xs[i], ys[j], zs[k]) of a box seen
+// from the field point, s = +1 or -1 the corner's sign (-1)^(i+j+k).
+template <class F>
+void for_each_corner(const double xs[2], const double ys[2], const double zs[2], F&& f) {
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k) {
+        const double s = ((i + j + k) % 2 == 0) ? 1.0 : -1.0;
+        const double X = xs[i], Y = ys[j], Z = zs[k];
+        const double R = std::sqrt(X * X + Y * Y + Z * Z);
+        f(s, X, Y, Z, R);
+      }
+}
+
 }  // namespace detail
 
 // Demagnetizing tensor field N(r) of the box of full edges `size`, centred at
@@ -132,16 +146,11 @@ inline SymTensor cuboid_demag_tensor(const Vec3& size, const Vec3& r) {
   const double ys[2] = {r.y + 0.5 * size.y, r.y - 0.5 * size.y};
   const double zs[2] = {r.z + 0.5 * size.z, r.z - 0.5 * size.z};
   double sxx = 0, syy = 0, szz = 0;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
-      for (int k = 0; k < 2; ++k) {
-        const double s = ((i + j + k) % 2 == 0) ? 1.0 : -1.0;
-        const double X = xs[i], Y = ys[j], Z = zs[k];
-        const double R = std::sqrt(X * X + Y * Y + Z * Z);
-        sxx += s * detail::corner_atan(X, Y, Z, R);
-        syy += s * detail::corner_atan(Y, Z, X, R);
-        szz += s * detail::corner_atan(Z, X, Y, R);
-      }
+  detail::for_each_corner(xs, ys, zs, [&](double s, double X, double Y, double Z, double R) {
+    sxx += s * detail::corner_atan(X, Y, Z, R);
+    syy += s * detail::corner_atan(Y, Z, X, R);
+    szz += s * detail::corner_atan(Z, X, Y, R);
+  });
   // Off-diagonals: sum over the corners of s log(W + R), W the third axis,
   // grouped into pairs along W (log_pair) for stability.
   double sxy = 0, syz = 0, szx = 0;
@@ -183,20 +192,12 @@ inline double cuboid_potential_local(const Vec3& size, const Vec3& M, const Vec3
   using detail::corner_atan;
   using detail::y_log_z_plus_r;
   double sum = 0.0;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
-      for (int k = 0; k < 2; ++k) {
-        const double s = ((i + j + k) % 2 == 0) ? 1.0 : -1.0;
-        const double X = xs[i], Y = ys[j], Z = zs[k];
-        const double R = std::sqrt(X * X + Y * Y + Z * Z);
-        const double px = y_log_z_plus_r(X, Y, Z, R) + y_log_z_plus_r(X, Z, Y, R) -
-                          X * corner_atan(X, Y, Z, R);
-        const double py = y_log_z_plus_r(Y, Z, X, R) + y_log_z_plus_r(Y, X, Z, R) -
-                          Y * corner_atan(Y, Z, X, R);
-        const double pz = y_log_z_plus_r(Z, X, Y, R) + y_log_z_plus_r(Z, Y, X, R) -
-                          Z * corner_atan(Z, X, Y, R);
-        sum += s * (M.x * px + M.y * py + M.z * pz);
-      }
+  detail::for_each_corner(xs, ys, zs, [&](double s, double X, double Y, double Z, double R) {
+    const double px = y_log_z_plus_r(X, Y, Z, R) + y_log_z_plus_r(X, Z, Y, R) - X * corner_atan(X, Y, Z, R);
+    const double py = y_log_z_plus_r(Y, Z, X, R) + y_log_z_plus_r(Y, X, Z, R) - Y * corner_atan(Y, Z, X, R);
+    const double pz = y_log_z_plus_r(Z, X, Y, R) + y_log_z_plus_r(Z, Y, X, R) - Z * corner_atan(Z, X, Y, R);
+    sum += s * (M.x * px + M.y * py + M.z * pz);
+  });
   return -sum / (4.0 * kRefPi);
 }
 
