@@ -21,16 +21,6 @@ constexpr double kMaxStepPerResidual = 30.0;
 // radius, and turn this many radians, from the pose last solved for.
 constexpr double kUnchangedDistance = 1e-5, kUnchangedRotation = 1e-5;
 
-std::vector<int> active_responsive_cells(const MagneticModel& model, const MagneticState& state) {
-  std::vector<int> cells;
-  for (int b = 0; b < model.body_count(); ++b) {
-    const MagneticBody& body = model.body(b);
-    if (!body.responsive() || !state.active[b]) continue;
-    for (int i = 0; i < body.cell_count(); ++i) cells.push_back(body.first_cell + i);
-  }
-  return cells;
-}
-
 // |H_A| + gamma_D |M| for soft cells, |H_A| + |M| / 3 for recoil magnets: the
 // field scale against which a cell's applied-field change is measured.
 double cell_field_scale(const MagneticModel& model, const MagneticState& state, int c,

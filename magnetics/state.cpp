@@ -126,6 +126,16 @@ double boundary_field_energy(const MagneticModel& model, const MagneticState& st
   return e;
 }
 
+std::vector<int> active_responsive_cells(const MagneticModel& model, const MagneticState& state) {
+  std::vector<int> cells;
+  for (int b = 0; b < model.body_count(); ++b) {
+    const MagneticBody& body = model.body(b);
+    if (!body.responsive() || !state.active[b]) continue;
+    for (int i = 0; i < body.cell_count(); ++i) cells.push_back(body.first_cell + i);
+  }
+  return cells;
+}
+
 Vec3 body_moment(const MagneticModel& model, const MagneticState& state, int b) {
   const MagneticBody& body = model.body(b);
   Vec3 mu;

@@ -72,6 +72,10 @@ void place_cells(const MagneticModel& model, MagneticState& state);
 // Magnetization of one cell from the state (soft: Ms mean(m_k) rotated to world).
 Vec3 soft_cell_magnetization(const MagneticModel& model, const MagneticState& state, int cell);
 
+// The cells a relaxation solves for: those of the active responsive (soft and
+// recoil) bodies, in cell order.
+std::vector<int> active_responsive_cells(const MagneticModel& model, const MagneticState& state);
+
 // Total moment of a body, sum of M V over its cells, world, A m^2.
 Vec3 body_moment(const MagneticModel& model, const MagneticState& state, int body);
 

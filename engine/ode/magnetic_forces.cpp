@@ -29,10 +29,15 @@ MagneticForces::MagneticForces(MagneticModel model, MagneticState state, const R
       backend_(backend ? std::move(backend) : make_cpu_backend()),
       options_(options) {}
 
-void MagneticForces::bind(int index, dBodyID body) {
+int MagneticForces::body_index(int index, const char* call) const {
   if (index < 0 || index >= model_.body_count())
-    throw std::out_of_range("MagneticForces::bind: no magnetic body " + std::to_string(index));
-  bodies_[index] = body;
+    throw std::out_of_range(std::string("MagneticForces::") + call + ": no magnetic body " + std::to_string(index) +
+                            " (" + std::to_string(model_.body_count()) + " attached)");
+  return index;
+}
+
+void MagneticForces::bind(int index, dBodyID body) {
+  bodies_[body_index(index, "bind")] = body;
   if (body) state_.pose[index] = ode_pose(body);
 }
 

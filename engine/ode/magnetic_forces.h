@@ -60,25 +60,31 @@ class MagneticForces : public ForceAccumulator {
 
   void set_external_field(const Vec3& H) { state_.external_field = H; }
   Vec3 external_field() const { return state_.external_field; }
+  // Every call taking a body index throws std::out_of_range when it is not
+  // 0 .. body_count() - 1.
   // A body that is not active neither makes nor feels a field (removed).
-  void set_active(int index, bool active) { state_.active[index] = active ? 1 : 0; }
-  bool active(int index) const { return state_.active[index] != 0; }
+  void set_active(int index, bool active) { state_.active[body_index(index, "set_active")] = active ? 1 : 0; }
+  bool active(int index) const { return state_.active[body_index(index, "active")] != 0; }
   // Scales a permanent magnet's remanent magnetization (electromagnets, the crane).
-  void set_magnetization_scale(int index, double scale) { state_.magnetization_scale[index] = scale; }
-  double magnetization_scale(int index) const { return state_.magnetization_scale[index]; }
+  void set_magnetization_scale(int index, double scale) {
+    state_.magnetization_scale[body_index(index, "set_magnetization_scale")] = scale;
+  }
+  double magnetization_scale(int index) const {
+    return state_.magnetization_scale[body_index(index, "magnetization_scale")];
+  }
   // Pose of a static (body == nullptr) magnetic body.
-  void set_pose(int index, const BodyPose& pose) { state_.pose[index] = pose; }
+  void set_pose(int index, const BodyPose& pose) { state_.pose[body_index(index, "set_pose")] = pose; }
 
   RelaxOptions& options() { return options_; }
   const RelaxOptions& options() const { return options_; }
   const RelaxReport& last_report() const { return report_; }
 
   int body_count() const { return model_.body_count(); }
-  dBodyID ode_body(int index) const { return bodies_[index]; }
+  dBodyID ode_body(int index) const { return bodies_[body_index(index, "ode_body")]; }
   // A m^2, world; zero for a body that is not active.
   Vec3 moment(int index) const { return active(index) ? body_moment(model_, state_, index) : Vec3{}; }
-  Vec3 force(int index) const { return state_.force[index]; }                  // N, world
-  Vec3 torque(int index) const { return state_.torque[index]; }                // N m, about the CoM
+  Vec3 force(int index) const { return state_.force[body_index(index, "force")]; }                  // N, world
+  Vec3 torque(int index) const { return state_.torque[body_index(index, "torque")]; }                // N m, about the CoM
 
   const MagneticModel& model() const { return model_; }
   const MagneticState& state() const { return state_; }
@@ -86,6 +92,8 @@ class MagneticForces : public ForceAccumulator {
   MagneticBackend& backend() { return *backend_; }
 
  private:
+  // index, or std::out_of_range naming the call when it is not a body index.
+  int body_index(int index, const char* call) const;
   void read_poses();
 
   MagneticModel model_;

@@ -86,15 +86,7 @@ struct Scene {
   MagneticModel model;
   MagneticState state;
   explicit Scene(IntraBodyTensor tensor = IntraBodyTensor::cell_average) : model(tensor) {}
-  std::vector<int> responsive_cells() const {
-    std::vector<int> cells;
-    for (int b = 0; b < model.body_count(); ++b) {
-      const MagneticBody& body = model.body(b);
-      if (!body.responsive() || !state.active[b]) continue;
-      for (int i = 0; i < body.cell_count(); ++i) cells.push_back(body.first_cell + i);
-    }
-    return cells;
-  }
+  std::vector<int> responsive_cells() const { return active_responsive_cells(model, state); }
   std::vector<int> bodies() const {
     std::vector<int> b(model.body_count());
     for (int i = 0; i < model.body_count(); ++i) b[i] = i;
