@@ -25,7 +25,10 @@ Moments rect_in_disc(double r, double x0, double x1, double y0, double y1) {
   if (r <= 0.0) return m;
   const double a = std::max(x0, -r), b = std::min(x1, r);
   if (b <= a) return m;
-  auto s = [r](double x) { return std::sqrt(std::max(0.0, r * r - x * x)); };
+  // (r - x)(r + x), not r^2 - x^2: exactly 0 at x = +-r whether or not the
+  // compiler fuses the multiply-add (fused, r^2 - x^2 left a rounding residue
+  // whose root, ~1e-11 r, put 2e-9 into a ball's total volume).
+  auto s = [r](double x) { return std::sqrt(std::max(0.0, (r - x) * (r + x))); };
   auto P = [&](double x) { return 0.5 * (x * s(x) + r * r * std::asin(std::clamp(x / r, -1.0, 1.0))); };  // int s
   auto Q = [&](double x) { const double t = s(x); return -t * t * t / 3.0; };                              // int x s
   auto S2 = [r](double x) { return r * r * x - x * x * x / 3.0; };                                          // int s^2
@@ -33,7 +36,7 @@ Moments rect_in_disc(double r, double x0, double x1, double y0, double y1) {
   int nb = 2;
   for (double y : {y0, y1})
     if (std::fabs(y) < r) {
-      const double c = std::sqrt(r * r - y * y);
+      const double c = std::sqrt((r - y) * (r + y));
       for (double p : {-c, c})
         if (p > a && p < b) breaks[nb++] = p;
     }
@@ -110,7 +113,7 @@ Moments box_in_ball(double R, const Vec3& lo, const Vec3& hi) {
   std::vector<double> xs = {x0, x1};
   for (int k = 0; k < nr; ++k)
     if (rho[k] < R) {
-      const double x = std::sqrt(R * R - rho[k] * rho[k]);
+      const double x = std::sqrt((R - rho[k]) * (R + rho[k]));
       for (double p : {-x, x})
         if (p > x0 && p < x1) xs.push_back(p);
     }
@@ -124,7 +127,7 @@ Moments box_in_ball(double R, const Vec3& lo, const Vec3& hi) {
       const double t = g.x[i];
       const double x = mid + half * 0.5 * (3.0 * t - t * t * t);
       const double wx = g.w[i] * half * 1.5 * (1.0 - t * t);
-      const Moments s = rect_in_disc(std::sqrt(std::max(0.0, R * R - x * x)), lo.y, hi.y, lo.z, hi.z);
+      const Moments s = rect_in_disc(std::sqrt(std::max(0.0, (R - x) * (R + x))), lo.y, hi.y, lo.z, hi.z);
       m.v += wx * s.v;
       m.x += wx * x * s.v;
       m.y += wx * s.x;
