@@ -32,6 +32,7 @@
 #include "gpu/cuda_check.cuh"
 #include "gpu/device_buffer.cuh"
 #include "gpu/device_data.cuh"
+#include "magnetics/cell_layout.h"
 #include "magnetics/field_probe.h"
 #include "magnetics/near_field.h"
 #include "magnetics/state.h"
@@ -179,17 +180,18 @@ class CudaBackend final : public MagneticBackend {
       d.kind = static_cast<int>(body.kind);
     }
 
-    // Cell lists in body order, then cell order (as the CPU backend).
-    resp_cells_.clear(), fixed_cells_.clear(), all_cells_.clear(), all_bodies_.clear();
+    // Cell lists in the order of the shared layout (magnetics/cell_layout.h),
+    // the CPU backend's order.
+    layout_.build(model, state);
     resp_soft_.clear(), all_positions_.clear(), moment_runs_.clear();
     h_resp_point_.clear(), h_fixed_point_.clear(), h_all_point_.clear();
     h_resp_body_.clear(), h_resp_key_.clear(), h_resp_moment_.clear();
     h_resp_volume_.clear(), h_all_volume_.clear();
     h_fixed_mu_.clear(), h_history_.clear(), h_counter_.clear();
     moment_total_ = 0;
-    for (int b = 0; b < model.body_count(); ++b) {
+    for (const CellRun& run : layout_.all.runs) {
+      const int b = run.body;
       const MagneticBody& body = model.body(b);
-      if (body.inert() || !state.active[b]) continue;
       const bool soft = body.kind == CellKind::soft;
       const int n = body.soft.n;
       size_t run_device = 0, run_host = 0;
@@ -200,23 +202,19 @@ class CudaBackend final : public MagneticBackend {
         moment_runs_.push_back({run_host, run_device, count});
         moment_total_ += count;
       }
-      for (int i = 0; i < body.cell_count(); ++i) {
-        const int c = body.first_cell + i;
+      for (int k = run.begin; k < run.end; ++k) {
+        const int c = layout_.all.cell[k], i = c - body.first_cell;
         const Vec3& x = state.cell_position[c];
         const CellPoint point{x.x, x.y, x.z, body.cells.contact_radii[i]};
         const double volume = body.cells.volumes[i];
-        all_cells_.push_back(c);
-        all_bodies_.push_back(b);
         all_positions_.push_back(x);
         h_all_point_.push_back(point);
         h_all_volume_.push_back(volume);
         if (!body.responsive()) {
-          fixed_cells_.push_back(c);
           h_fixed_point_.push_back(point);
           h_fixed_mu_.push_back(volume * state.magnetization[c]);
           continue;
         }
-        resp_cells_.push_back(c);
         h_resp_volume_.push_back(volume);
         resp_soft_.push_back(soft ? 1 : 0);
         h_resp_point_.push_back(point);
@@ -252,7 +250,7 @@ class CudaBackend final : public MagneticBackend {
     resp_point_.upload(h_resp_point_.data(), h_resp_point_.size(), s);
     resp_body_.upload(h_resp_body_.data(), h_resp_body_.size(), s);
     resp_key_.upload(h_resp_key_.data(), h_resp_key_.size(), s);
-    resp_cell_.upload(resp_cells_.data(), resp_cells_.size(), s);
+    resp_cell_.upload(layout_.responsive.cell.data(), layout_.responsive.cell.size(), s);
     resp_moment_.upload(h_resp_moment_.data(), h_resp_moment_.size(), s);
     resp_volume_.upload(h_resp_volume_.data(), h_resp_volume_.size(), s);
     all_volume_.upload(h_all_volume_.data(), h_all_volume_.size(), s);
@@ -261,7 +259,7 @@ class CudaBackend final : public MagneticBackend {
     fixed_point_.upload(h_fixed_point_.data(), h_fixed_point_.size(), s);
     fixed_mu_.upload(h_fixed_mu_.data(), h_fixed_mu_.size(), s);
     all_point_.upload(h_all_point_.data(), h_all_point_.size(), s);
-    all_body_.upload(all_bodies_.data(), all_bodies_.size(), s);
+    all_body_.upload(layout_.all.body.data(), layout_.all.body.size(), s);
     moments_.upload(h_moments_.data(), h_moments_.size(), s);
     hc_prev_.upload(h_hc_prev_.data(), h_hc_prev_.size(), s);
     up += bodies_.bytes() + resp_point_.bytes() + resp_body_.bytes() + resp_key_.bytes() +
@@ -289,7 +287,7 @@ class CudaBackend final : public MagneticBackend {
     CallTimer timer(events_, stream(), stats_.fixed_field);
     timer.uploads_done();
     resp_H_.resize(n);
-    gpu::launch_fixed_field({n, resp_point_.data(), static_cast<int>(fixed_cells_.size()),
+    gpu::launch_fixed_field({n, resp_point_.data(), layout_.fixed.size(),
                              fixed_point_.data(), fixed_mu_.data(), state.external_field,
                              resp_H_.data()},
                             stream());
@@ -297,7 +295,7 @@ class CudaBackend final : public MagneticBackend {
     pin_out_.resize(n);
     resp_H_.download(pin_out_.data(), n, stream());
     timer.synchronize(0.0, bytes_of<Vec3>(n));
-    for (int i = 0; i < n; ++i) H[resp_cells_[i]] = pin_out_[i];
+    for (int i = 0; i < n; ++i) H[layout_.responsive.cell[i]] = pin_out_[i];
     near_.add_field(model, state, NearFieldSources::fixed, H);
     timer.stop();
   }
@@ -310,7 +308,7 @@ class CudaBackend final : public MagneticBackend {
     CallTimer timer(events_, stream(), stats_.responsive_field);
     const cudaStream_t s = stream();
     pin_in_.resize(n);
-    for (int i = 0; i < n; ++i) pin_in_[i] = state.magnetization[resp_cells_[i]];
+    for (int i = 0; i < n; ++i) pin_in_[i] = state.magnetization[layout_.responsive.cell[i]];
     resp_M_.upload(pin_in_.data(), n, s);
     timer.uploads_done();
     resp_mu_.resize(n);
@@ -327,7 +325,7 @@ class CudaBackend final : public MagneticBackend {
     pin_out_.resize(n);
     resp_H_.download(pin_out_.data(), n, s);
     timer.synchronize(bytes_of<Vec3>(n), bytes_of<Vec3>(n));
-    for (int i = 0; i < n; ++i) H[resp_cells_[i]] = pin_out_[i];
+    for (int i = 0; i < n; ++i) H[layout_.responsive.cell[i]] = pin_out_[i];
     add_boundary_field(model, state, H);
     near_.add_field(model, state, NearFieldSources::responsive, H);
     timer.stop();
@@ -341,7 +339,7 @@ class CudaBackend final : public MagneticBackend {
     CallTimer timer(events_, stream(), stats_.relax_cells);
     const cudaStream_t s = stream();
     pin_in_.resize(n);
-    for (int i = 0; i < n; ++i) pin_in_[i] = H_A[resp_cells_[i]];
+    for (int i = 0; i < n; ++i) pin_in_[i] = H_A[layout_.responsive.cell[i]];
     resp_applied_.upload(pin_in_.data(), n, s);
     ODEMAG_CUDA_CHECK(cudaMemsetAsync(totals_.data(), 0, sizeof(gpu::RelaxTotals), s));
     timer.uploads_done();
@@ -369,7 +367,7 @@ class CudaBackend final : public MagneticBackend {
                       bytes_of<Vec3>(n) + 2 * bytes_of<Vec3>(moment_total_) + bytes_of<uint8_t>(n) +
                           bytes_of<uint64_t>(n) + sizeof(gpu::RelaxTotals));
     for (int i = 0; i < n; ++i) {
-      const int c = resp_cells_[i];
+      const int c = layout_.responsive.cell[i];
       state.magnetization[c] = pin_out_[i];
       if (!resp_soft_[i]) continue;  // recoil magnets have no moments
       state.llg_history[c] = pin_history_[i];
@@ -390,13 +388,13 @@ class CudaBackend final : public MagneticBackend {
   void forces(const MagneticModel& model, MagneticState& state) override {
     std::fill(state.force.begin(), state.force.end(), Vec3{});
     std::fill(state.torque.begin(), state.torque.end(), Vec3{});
-    const int n = static_cast<int>(all_cells_.size());
+    const int n = layout_.all.size();
     if (n == 0) return;
     select(device_);
     CallTimer timer(events_, stream(), stats_.forces);
     const cudaStream_t s = stream();
     pin_in_.resize(n);
-    for (int i = 0; i < n; ++i) pin_in_[i] = state.magnetization[all_cells_[i]];
+    for (int i = 0; i < n; ++i) pin_in_[i] = state.magnetization[layout_.all.cell[i]];
     all_M_.upload(pin_in_.data(), n, s);
     timer.uploads_done();
     all_mu_.resize(n);
@@ -417,15 +415,15 @@ class CudaBackend final : public MagneticBackend {
       near_field_at_.assign(model.cell_count(), {});
       near_.add_forces(model, state, near_force_, near_field_at_);
       for (int i = 0; i < n; ++i) {
-        pin_out_[i] += near_force_[all_cells_[i]];
-        pin_out2_[i] += near_field_at_[all_cells_[i]];
+        pin_out_[i] += near_force_[layout_.all.cell[i]];
+        pin_out2_[i] += near_field_at_[layout_.all.cell[i]];
       }
     }
     // Per-body sums in cell order, as the CPU backend.
     for (int i = 0; i < n; ++i) {
-      const int b = all_bodies_[i];
+      const int b = layout_.all.body[i];
       const Vec3& xi = all_positions_[i];
-      const Vec3 mi = h_all_volume_[i] * state.magnetization[all_cells_[i]];
+      const Vec3 mi = h_all_volume_[i] * state.magnetization[layout_.all.cell[i]];
       const Vec3& f = pin_out_[i];
       state.force[b] += f;
       state.torque[b] += cell_torque(xi - state.pose[b].position, f, mi, pin_out2_[i] + state.external_field);
@@ -433,14 +431,14 @@ class CudaBackend final : public MagneticBackend {
     timer.stop();
   }
 
-  void field_at_points(const MagneticModel& model, const MagneticState& state,
-                       const std::vector<Vec3>& points, std::vector<Vec3>& H) override {
+  void probe_field(const MagneticModel& model, const MagneticState& state,
+                   const std::vector<Vec3>& points, std::vector<Vec3>& H) override {
     const std::vector<ProbeCell> cells = probe_cells(model, state);
     const int n = static_cast<int>(points.size());
     H.resize(n);
     if (n == 0) return;
     select(device_);
-    CallTimer timer(events_, stream(), stats_.field_at_points);
+    CallTimer timer(events_, stream(), stats_.probe_field);
     const cudaStream_t s = stream();
     probe_cells_.upload(cells.data(), cells.size(), s);
     probe_points_.upload(points.data(), points.size(), s);
@@ -467,7 +465,7 @@ class CudaBackend final : public MagneticBackend {
     return device;
   }
   cudaStream_t stream() const { return stream_.get(); }
-  int responsive_count() const { return static_cast<int>(resp_cells_.size()); }
+  int responsive_count() const { return layout_.responsive.size(); }
 
   // The offset tensors of every body in one device array, uploaded when the
   // model's tables changed. Returns the bytes uploaded.
@@ -496,7 +494,7 @@ class CudaBackend final : public MagneticBackend {
   CudaBackendStats stats_;
 
   // This step's cell lists on the host (begin_step).
-  std::vector<int> resp_cells_, fixed_cells_, all_cells_, all_bodies_;
+  CellLayout layout_;
   std::vector<uint8_t> resp_soft_;
   std::vector<Vec3> all_positions_;
   std::vector<MomentRun> moment_runs_;
