@@ -12,7 +12,7 @@
 namespace odemag {
 
 // Forwards every call to `inner`; begin_s .. forces_s add up the seconds spent
-// in each kind of call (field_at_points is not timed).
+// in each kind of call (probe_field is not timed).
 class TimedBackend final : public MagneticBackend {
  public:
   explicit TimedBackend(std::unique_ptr<MagneticBackend> inner) : inner_(std::move(inner)) {}
@@ -37,9 +37,9 @@ class TimedBackend final : public MagneticBackend {
   void forces(const MagneticModel& m, MagneticState& s) override {
     timed(forces_s, [&] { inner_->forces(m, s); });
   }
-  void field_at_points(const MagneticModel& m, const MagneticState& s, const std::vector<Vec3>& p,
-                       std::vector<Vec3>& H) override {
-    inner_->field_at_points(m, s, p, H);
+  void probe_field(const MagneticModel& m, const MagneticState& s, const std::vector<Vec3>& p,
+                   std::vector<Vec3>& H) override {
+    inner_->probe_field(m, s, p, H);
   }
   void reset() { begin_s = fixed_s = field_s = local_s = forces_s = 0.0; }
   double begin_s = 0, fixed_s = 0, field_s = 0, local_s = 0, forces_s = 0;

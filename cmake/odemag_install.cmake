@@ -40,7 +40,7 @@ set(ODEMAG_PUBLIC_HEADERS
   engine/ode/magnetic_forces.h engine/ode/force_accumulator.h       # embedding
   engine/scene/scene.h                                              # scene loading
   engine/sim/simulation.h engine/sim/rigid_world.h engine/sim/frame_writer.h
-  engine/sim/magnetic_scene.h                                       # simulation
+  engine/sim/magnetic_system.h                                      # simulation
   gpu/cuda_backend.h
   magnetics/backend.h magnetics/cells.h magnetics/constants.h magnetics/demag_tensor.h
   magnetics/hd.h magnetics/llg.h magnetics/material.h magnetics/model.h magnetics/relax.h

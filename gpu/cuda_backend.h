@@ -30,7 +30,7 @@ struct CudaCallStats {
 };
 
 struct CudaBackendStats {
-  CudaCallStats begin_step, fixed_field, responsive_field, relax_cells, forces, field_at_points;
+  CudaCallStats begin_step, fixed_field, responsive_field, relax_cells, forces, probe_field;
 };
 
 // The statistics of a backend made by make_cuda_backend; zeros for any other.

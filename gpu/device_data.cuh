@@ -133,7 +133,7 @@ struct CellForcesArgs {
 };
 void launch_cell_forces(const CellForcesArgs& a, cudaStream_t stream);
 
-// H at points from H_E and every probe cell (field_at_points).
+// H at points from H_E and every probe cell (MagneticBackend::probe_field).
 struct ProbeFieldArgs {
   int points;
   const Vec3* point;

@@ -62,8 +62,8 @@ class MagneticBackend {
 
   // H (A/m) at world points from H_E and every active cell, each cell the
   // uniformly magnetized solid it stands for (magnetics/field_probe.h).
-  virtual void field_at_points(const MagneticModel& model, const MagneticState& state,
-                               const std::vector<Vec3>& points, std::vector<Vec3>& H) = 0;
+  virtual void probe_field(const MagneticModel& model, const MagneticState& state,
+                           const std::vector<Vec3>& points, std::vector<Vec3>& H) = 0;
 };
 
 // threads <= 0: all cores (OpenMP default).

@@ -390,7 +390,7 @@ RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
 void field_at_points(const MagneticModel& model, const MagneticState& state,
                      MagneticBackend& backend, const std::vector<Vec3>& points,
                      std::vector<Vec3>& B, std::vector<Vec3>& H) {
-  backend.field_at_points(model, state, points, H);
+  backend.probe_field(model, state, points, H);
   B.resize(points.size());
   for (size_t p = 0; p < points.size(); ++p) {
     Vec3 M;

@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "demos/cli/cli.h"
-#include "engine/sim/magnetic_scene.h"
+#include "engine/sim/magnetic_system.h"
 #include "engine/scene/scene.h"
 #include "magnetics/relax.h"
 
@@ -87,7 +87,7 @@ int run_solve(const std::vector<std::string>& args) {
   const SolveCommandLine c = parse_solve_command(args);
   const SolveOptions& options = c.solve;
   const SceneDescription scene = load_scene(c.scene);
-  MagneticScene ms = build_magnetic_scene(scene);
+  MagneticSystem ms = build_magnetic_system(scene);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
   const RelaxReport report = magnetic_step(ms.model, ms.state, scene.solver.relax, *backend);
 
@@ -126,7 +126,7 @@ int run_field(const std::vector<std::string>& args) {
 
   const SceneDescription scene = load_scene(c.scene);
   const std::vector<Vec3> points = read_points(c.points);
-  MagneticScene ms = build_magnetic_scene(scene);
+  MagneticSystem ms = build_magnetic_system(scene);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
   const RelaxReport report = relax(ms.model, ms.state, scene.solver.relax, *backend);
   std::vector<Vec3> B, H;

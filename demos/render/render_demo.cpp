@@ -18,7 +18,7 @@ namespace {
 using odemag::Mat3;
 using odemag::RenderLine;
 using odemag::RenderPrimitive;
-using odemag::RenderScene;
+using odemag::RenderFrame;
 using odemag::Vec3;
 
 Mat3 rotation_z(double angle) {
@@ -30,8 +30,8 @@ Mat3 rotation_z(double angle) {
   return r;
 }
 
-RenderScene demo_scene(int width, int height) {
-  RenderScene scene;
+RenderFrame demo_scene(int width, int height) {
+  RenderFrame scene;
   scene.camera.position = {0.085, -0.15, 0.085};
   scene.camera.target = {0.0, -0.01, 0.025};
   scene.camera.width = width;
@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
   const int supersample = argc > 4 ? std::atoi(argv[4]) : 2;
   try {
     odemag::OffscreenRenderer renderer(width, height, supersample);
-    const RenderScene scene = demo_scene(width, height);
+    const RenderFrame scene = demo_scene(width, height);
     auto rgb = renderer.render(scene);  // warm-up
     const int frames = 20;
     const auto t0 = std::chrono::steady_clock::now();

@@ -322,12 +322,12 @@ struct OffscreenRenderer::Impl {
     return cube_list;
   }
 
-  void draw_ground(const RenderScene& scene);
-  void draw_shadows(const RenderScene& scene, const ViewInfo& view, const Vec3& light);
+  void draw_ground(const RenderFrame& scene);
+  void draw_shadows(const RenderFrame& scene, const ViewInfo& view, const Vec3& light);
   void draw_primitive(const RenderPrimitive& p, const ViewInfo& view);
-  void draw_lines(const RenderScene& scene);
+  void draw_lines(const RenderFrame& scene);
   void downsample(std::vector<std::uint8_t>& rgb) const;
-  void draw_caption(const RenderScene& scene, std::vector<std::uint8_t>& rgb) const;
+  void draw_caption(const RenderFrame& scene, std::vector<std::uint8_t>& rgb) const;
 };
 
 OffscreenRenderer::OffscreenRenderer(int width, int height, int supersample)
@@ -385,7 +385,7 @@ constexpr float kShadowAlpha = 0.30f;
 
 }  // namespace
 
-void OffscreenRenderer::Impl::draw_ground(const RenderScene& scene) {
+void OffscreenRenderer::Impl::draw_ground(const RenderFrame& scene) {
   const double extent = std::fabs(scene.ground_extent);
   double tile = scene.ground_tile > 0.0 ? scene.ground_tile : extent / 8.0;
   const int max_tiles = 400;  // per side
@@ -408,7 +408,7 @@ void OffscreenRenderer::Impl::draw_ground(const RenderScene& scene) {
   glEnd();
 }
 
-void OffscreenRenderer::Impl::draw_shadows(const RenderScene& scene, const ViewInfo& view, const Vec3& light) {
+void OffscreenRenderer::Impl::draw_shadows(const RenderFrame& scene, const ViewInfo& view, const Vec3& light) {
   // Darken ground pixels (stencil 1) once each, wherever a primitive's
   // projection along the light onto the ground plane lands.
   glEnable(GL_STENCIL_TEST);
@@ -474,7 +474,7 @@ void OffscreenRenderer::Impl::draw_primitive(const RenderPrimitive& p, const Vie
   glDisable(GL_CLIP_PLANE0);
 }
 
-void OffscreenRenderer::Impl::draw_lines(const RenderScene& scene) {
+void OffscreenRenderer::Impl::draw_lines(const RenderFrame& scene) {
   glDisable(GL_LIGHTING);
   glDisable(GL_CULL_FACE);
   glDisableClientState(GL_NORMAL_ARRAY);
@@ -517,7 +517,7 @@ void OffscreenRenderer::Impl::downsample(std::vector<std::uint8_t>& rgb) const {
   }
 }
 
-void OffscreenRenderer::Impl::draw_caption(const RenderScene& scene, std::vector<std::uint8_t>& rgb) const {
+void OffscreenRenderer::Impl::draw_caption(const RenderFrame& scene, std::vector<std::uint8_t>& rgb) const {
   if (scene.text.empty()) return;
   const int scale = std::max(1, height / 240);
   const int margin = 4 * scale, pad = 2 * scale;
@@ -543,7 +543,7 @@ void OffscreenRenderer::Impl::draw_caption(const RenderScene& scene, std::vector
   }
 }
 
-std::vector<std::uint8_t> OffscreenRenderer::render(const RenderScene& scene) {
+std::vector<std::uint8_t> OffscreenRenderer::render(const RenderFrame& scene) {
   Impl& m = *impl_;
   m.make_current();
 

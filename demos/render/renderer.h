@@ -60,7 +60,7 @@ struct RenderLine {
   float width = 1.5f;
 };
 
-struct RenderScene {
+struct RenderFrame {
   RenderCamera camera;
   RenderColor background{0.93f, 0.94f, 0.96f};
   // Checkerboard ground plane in light greys: the square |x|, |y| <=
@@ -99,7 +99,7 @@ class OffscreenRenderer {
   // Renders the scene and returns tightly packed RGB8 rows, top row first:
   // width * height * 3 bytes. Throws std::runtime_error if the context cannot
   // be made current.
-  std::vector<std::uint8_t> render(const RenderScene& scene);
+  std::vector<std::uint8_t> render(const RenderFrame& scene);
 
  private:
   struct Impl;

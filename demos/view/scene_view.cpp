@@ -118,11 +118,11 @@ std::vector<RenderLine> trace_field_lines(const MagneticModel& model, const Magn
   return lines;
 }
 
-RenderScene render_scene_of(const Simulation& sim, const ViewOptions& options, MagneticBackend* field_backend) {
+RenderFrame render_scene_of(const Simulation& sim, const ViewOptions& options, MagneticBackend* field_backend) {
   const SceneDescription& scene = sim.scene();
   const MagneticForces& magnetics = sim.magnetics();
   const MagneticModel& model = magnetics.model();
-  RenderScene view;
+  RenderFrame view;
   view.camera.position = scene.camera.position;
   view.camera.target = scene.camera.target;
   view.camera.up = scene.camera.up;
@@ -183,7 +183,7 @@ class PngFrameWriter final : public FrameWriter {
         field_backend_(options_.field_lines ? make_cpu_backend(1) : nullptr) {}
 
   void write(const Simulation& simulation, const std::string& path) override {
-    const RenderScene view = render_scene_of(simulation, options_, field_backend_.get());
+    const RenderFrame view = render_scene_of(simulation, options_, field_backend_.get());
     const std::vector<std::uint8_t> rgb = renderer_.render(view);
     std::string error;
     if (!write_png(path, renderer_.width(), renderer_.height(), rgb, &error))

@@ -32,7 +32,7 @@ std::vector<RenderLine> trace_field_lines(const MagneticModel& model, const Magn
 
 // What to draw for the simulation's current state, seen by the scene camera.
 // field_backend is used for field lines (may be null when they are off).
-RenderScene render_scene_of(const Simulation& sim, const ViewOptions& options,
+RenderFrame render_scene_of(const Simulation& sim, const ViewOptions& options,
                             MagneticBackend* field_backend);
 
 // Frames for `odemag run`: renders with OSMesa and writes PNGs atomically.

@@ -33,7 +33,7 @@ class MagneticForces : public ForceAccumulator {
                           std::unique_ptr<MagneticBackend> backend = nullptr, uint64_t seed = 1,
                           IntraBodyTensor intra_tensor = IntraBodyTensor::cell_average);
 
-  // Magnetics built elsewhere (a scene's, engine/sim/magnetic_scene.h): the
+  // Magnetics built elsewhere (a scene's, engine/sim/magnetic_system.h): the
   // model and its state as they are; bind() then ties bodies to ODE bodies.
   MagneticForces(MagneticModel model, MagneticState state, const RelaxOptions& options,
                  std::unique_ptr<MagneticBackend> backend);

@@ -1,4 +1,4 @@
-#include "engine/sim/magnetic_scene.h"
+#include "engine/sim/magnetic_system.h"
 
 #include <stdexcept>
 
@@ -14,8 +14,8 @@ BodyPose scene_pose(const BodyDescription& body) {
   return pose;
 }
 
-MagneticScene build_magnetic_scene(const SceneDescription& scene) {
-  MagneticScene ms;
+MagneticSystem build_magnetic_system(const SceneDescription& scene) {
+  MagneticSystem ms;
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodyDescription& body = scene.bodies[b];
     const auto material = scene.materials.find(body.material);

@@ -12,13 +12,15 @@
 
 namespace odemag {
 
-struct MagneticScene {
+// The magnetic system of a scene: its model and its state. ("Scene" names one
+// type, the scene file's SceneDescription; the renderer draws RenderFrames.)
+struct MagneticSystem {
   MagneticModel model;
   MagneticState state;  // poses from the scene, bodies with present=false inactive
 };
 
 // Throws SceneError naming the body when a shape or material is rejected.
-MagneticScene build_magnetic_scene(const SceneDescription& scene);
+MagneticSystem build_magnetic_system(const SceneDescription& scene);
 
 // The body's pose in the scene description.
 BodyPose scene_pose(const BodyDescription& body);

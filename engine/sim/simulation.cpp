@@ -6,7 +6,9 @@
 #include <stdexcept>
 #include <variant>
 
-#include "engine/sim/magnetic_scene.h"
+#include <Eigen/Geometry>
+
+#include "engine/sim/magnetic_system.h"
 #include "magnetics/constants.h"
 
 namespace odemag {
@@ -17,19 +19,11 @@ double elapsed_ms(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since).count();
 }
 
-Quaternion slerp(Quaternion a, Quaternion b, double u) {
-  double d = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
-  if (d < 0.0) {  // shorter arc
-    b = {-b.w, -b.x, -b.y, -b.z};
-    d = -d;
-  }
-  double wa = 1.0 - u, wb = u;
-  if (d < 0.9995) {
-    const double theta = std::acos(d), s = std::sin(theta);
-    wa = std::sin((1.0 - u) * theta) / s;
-    wb = std::sin(u * theta) / s;
-  }
-  return {wa * a.w + wb * b.w, wa * a.x + wb * b.x, wa * a.y + wb * b.y, wa * a.z + wb * b.z};
+// Spherical linear interpolation from a (u = 0) to b (u = 1) along the shorter arc.
+Quaternion slerp(const Quaternion& a, const Quaternion& b, double u) {
+  const Eigen::Quaterniond q =
+      Eigen::Quaterniond(a.w, a.x, a.y, a.z).slerp(u, Eigen::Quaterniond(b.w, b.x, b.y, b.z));
+  return {q.w(), q.x(), q.y(), q.z()};
 }
 
 // Angular velocity that turns rotation A into rotation B in time dt.
@@ -65,8 +59,8 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
     : scene_(scene) {
   world_ = std::make_unique<RigidWorld>(scene_);
   // The magnetic model of the scene, built as for solve and field
-  // (build_magnetic_scene), then tied to the ODE bodies.
-  MagneticScene ms = build_magnetic_scene(scene_);
+  // (build_magnetic_system), then tied to the ODE bodies.
+  MagneticSystem ms = build_magnetic_system(scene_);
   magnetics_ = std::make_unique<MagneticForces>(
       std::move(ms.model), std::move(ms.state), scene_.solver.relax,
       backend ? std::move(backend) : make_cpu_backend(scene_.solver.threads));

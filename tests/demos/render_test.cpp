@@ -32,8 +32,8 @@ Pixel at(const std::vector<std::uint8_t>& rgb, int width, int x, int y) {
 
 // A scene without ground, looked at from (0, -0.5, 0) towards the origin:
 // +x is to the right of the image, +z up.
-RenderScene front_scene() {
-  RenderScene scene;
+RenderFrame front_scene() {
+  RenderFrame scene;
   scene.ground = false;
   scene.camera.position = {0.0, -0.5, 0.0};
   scene.camera.target = {0.0, 0.0, 0.0};
@@ -66,7 +66,7 @@ void expect_background(const Pixel& p, const RenderColor& bg) {
 }
 
 TEST(RenderPixels, SphereAtCentreAndBoxWhereItProjects) {
-  RenderScene scene = front_scene();
+  RenderFrame scene = front_scene();
   scene.primitives.push_back(RenderPrimitive::sphere({0, 0, 0}, 0.08, {0.9f, 0.1f, 0.1f}));
   const Vec3 box_centre{-0.14, 0.0, 0.0};
   scene.primitives.push_back(RenderPrimitive::box(box_centre, {0.05, 0.05, 0.05}, Mat3{}, {0.1f, 0.8f, 0.1f}));
@@ -95,7 +95,7 @@ TEST(RenderPixels, SphereAtCentreAndBoxWhereItProjects) {
 
 TEST(RenderPixels, BoxAboveCentreAppearsInUpperHalf) {
   // Guards the vertical flip: +z must be up in the image (top row first).
-  RenderScene scene = front_scene();
+  RenderFrame scene = front_scene();
   const Vec3 box_centre{0.0, 0.0, 0.1};
   scene.primitives.push_back(RenderPrimitive::box(box_centre, {0.05, 0.05, 0.05}, Mat3{}, {0.1f, 0.8f, 0.1f}));
   OffscreenRenderer renderer(kW, kH);
@@ -109,7 +109,7 @@ TEST(RenderPixels, BoxAboveCentreAppearsInUpperHalf) {
 }
 
 TEST(RenderMagnet, PolesColourTheirHalves) {
-  RenderScene scene = front_scene();
+  RenderFrame scene = front_scene();
   RenderPrimitive magnet = RenderPrimitive::box({0, 0, 0}, {0.2, 0.05, 0.05}, Mat3{}, {0.5f, 0.5f, 0.5f});
   magnet.pole_axis = {1.0, 0.0, 0.0};
   scene.primitives.push_back(magnet);
@@ -144,7 +144,7 @@ TEST(RenderMagnet, PolesColourTheirHalves) {
 
 TEST(RenderMagnet, CylinderAndSphereMagnetsSplit) {
   for (const auto kind : {RenderPrimitive::Kind::cylinder, RenderPrimitive::Kind::sphere}) {
-    RenderScene scene = front_scene();
+    RenderFrame scene = front_scene();
     RenderPrimitive magnet;
     magnet.kind = kind;
     magnet.size = {0.08, 0.08, 0.08};
@@ -160,7 +160,7 @@ TEST(RenderMagnet, CylinderAndSphereMagnetsSplit) {
 }
 
 TEST(RenderDepth, NearSphereHidesFarSphereInEitherDrawOrder) {
-  RenderScene scene = front_scene();
+  RenderFrame scene = front_scene();
   const RenderPrimitive near_blue = RenderPrimitive::sphere({0, -0.2, 0}, 0.04, {0.1f, 0.2f, 0.9f});
   const RenderPrimitive far_red = RenderPrimitive::sphere({0, 0.2, 0}, 0.15, {0.9f, 0.1f, 0.1f});
   OffscreenRenderer renderer(kW, kH);
@@ -175,7 +175,7 @@ TEST(RenderDepth, NearSphereHidesFarSphereInEitherDrawOrder) {
 }
 
 TEST(RenderLines, LineDrawnAndHiddenBehindSolid) {
-  RenderScene scene = front_scene();
+  RenderFrame scene = front_scene();
   scene.primitives.push_back(RenderPrimitive::sphere({0, 0, 0}, 0.06, {0.9f, 0.1f, 0.1f}));
   RenderLine line;  // horizontal, behind the sphere
   line.points = {{-0.3, 0.1, 0.0}, {0.0, 0.1, 0.0}, {0.3, 0.1, 0.0}};
@@ -191,7 +191,7 @@ TEST(RenderLines, LineDrawnAndHiddenBehindSolid) {
 }
 
 TEST(RenderGround, CheckerboardBelowHorizonBackgroundAbove) {
-  RenderScene scene;
+  RenderFrame scene;
   scene.camera.position = {0.0, -0.6, 0.3};
   scene.camera.target = {0.0, 0.0, 0.0};
   scene.ground_extent = 0.5;
@@ -209,7 +209,7 @@ TEST(RenderGround, CheckerboardBelowHorizonBackgroundAbove) {
 // The scene is drawn at scale s (metres per unit) to cover both the
 // centimetre scenes of the demos and larger ones.
 int expect_solid_shadow(RenderPrimitive body, double s, int min_darker) {
-  RenderScene scene;
+  RenderFrame scene;
   scene.camera.position = {0.0, -0.6 * s, 0.4 * s};
   scene.camera.target = {0.0, 0.0, 0.0};
   scene.ground_extent = 0.5 * s;
@@ -254,7 +254,7 @@ TEST(RenderGround, BodiesCastSolidShadows) {
 }
 
 TEST(RenderText, CaptionDrawsDarkPixelsTopLeft) {
-  RenderScene scene = front_scene();
+  RenderFrame scene = front_scene();
   OffscreenRenderer renderer(kW, kH);
   const auto plain = renderer.render(scene);
   scene.text = {"t = 0.40 s"};
@@ -389,7 +389,7 @@ TEST(RenderPng, WrongBufferSizeFails) {
 
 TEST(RenderPng, RenderedFrameRoundTrips) {
   const auto dir = scratch_dir("png_frame");
-  RenderScene scene = front_scene();
+  RenderFrame scene = front_scene();
   scene.primitives.push_back(RenderPrimitive::sphere({0, 0, 0}, 0.08, {0.9f, 0.1f, 0.1f}));
   OffscreenRenderer renderer(kW, kH);
   const auto rgb = renderer.render(scene);

@@ -42,7 +42,7 @@ TEST(SceneView, MagnetsSplitAlongTheirMagnetizationOthersInTheirColours) {
   scene.material_colors["wood"] = {0.6, 0.4, 0.2};
   Simulation sim(scene, make_cpu_backend(1));
   sim.step();
-  const RenderScene view = render_scene_of(sim, ViewOptions{}, nullptr);
+  const RenderFrame view = render_scene_of(sim, ViewOptions{}, nullptr);
   ASSERT_EQ(view.primitives.size(), 3u);
   EXPECT_GT(view.primitives[0].pole_axis.x, 0.99);          // north along +M
   EXPECT_EQ(norm(view.primitives[1].pole_axis), 0.0);       // soft ball: one colour
@@ -56,7 +56,7 @@ TEST(SceneView, ForceColoursRankBodiesByForce) {
   scene.render.force_colors = true;
   Simulation sim(scene, make_cpu_backend(1));
   sim.step();
-  const RenderScene view = render_scene_of(sim, view_options(scene), nullptr);
+  const RenderFrame view = render_scene_of(sim, view_options(scene), nullptr);
   // The ball feels the largest force: red (t = 1); the magnet keeps its poles.
   EXPECT_LT(hue_degrees(view.primitives[1].color), 10.0);
 }

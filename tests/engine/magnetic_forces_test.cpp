@@ -10,7 +10,7 @@
 
 #include "engine/ode/magnetic_forces.h"
 #include "engine/scene/scene.h"
-#include "engine/sim/magnetic_scene.h"
+#include "engine/sim/magnetic_system.h"
 
 namespace odemag {
 namespace {
@@ -76,7 +76,7 @@ TEST(MagneticForcesApi, SceneBuiltAndBoundEqualsAttachedOneByOne) {
   OdeWorld ode;
   RelaxOptions options = scene.solver.relax;
 
-  MagneticScene ms = build_magnetic_scene(scene);
+  MagneticSystem ms = build_magnetic_system(scene);
   MagneticForces bound(std::move(ms.model), std::move(ms.state), options, make_cpu_backend(1));
   MagneticForces attached(options, make_cpu_backend(1), scene.seed);
   attached.set_external_field(scene.external_field);

@@ -289,15 +289,15 @@ TEST(CudaParity, FieldAtPoints) {
   points.push_back({1.0, -2.0, 0.5});  // far away
   auto cpu = make_cpu_backend(2);
   std::vector<Vec3> a, b;
-  cpu->field_at_points(s.model, s.state, points, a);
-  cuda->field_at_points(s.model, s.state, points, b);
+  cpu->probe_field(s.model, s.state, points, a);
+  cuda->probe_field(s.model, s.state, points, b);
   ASSERT_EQ(a.size(), points.size());
   ASSERT_EQ(b.size(), points.size());
   std::vector<int> all(points.size());
   for (size_t p = 0; p < points.size(); ++p) all[p] = static_cast<int>(p);
   EXPECT_TRUE(close(a, b, all, kProbeTolerance));
   std::vector<Vec3> none;
-  cuda->field_at_points(s.model, s.state, {}, none);
+  cuda->probe_field(s.model, s.state, {}, none);
   EXPECT_TRUE(none.empty());
 }
 
