@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <stdexcept>
 
 #include "magnetics/cell_field.h"
 #include "magnetics/constants.h"
@@ -412,25 +413,9 @@ void uniform_demag_over_cell(const Shape& shape, const CellSet& cells, int i, do
   }
   std::visit(Overloaded{
                  [&](const Sphere&) { n[0] = n[3] = n[5] = 1.0 / 3.0; },
-                 [&](const Box& b) {
-                   // The cell's box: the cube clipped to the body.
-                   const Vec3 e = 0.5 * b.size;
-                   double lo[3], hi[3];
-                   for (int k = 0; k < 3; ++k) {
-                     lo[k] = std::max(rlo[k], -e[k]);
-                     hi[k] = std::min(rhi[k], e[k]);
-                   }
-                   for (int u = 0; u < 3; ++u)
-                     for (int v = 0; v < 3; ++v)
-                       for (int w = 0; w < 3; ++w) {
-                         const Vec3 q{0.5 * (lo[0] + hi[0]) + 0.5 * (hi[0] - lo[0]) * g3x[u],
-                                      0.5 * (lo[1] + hi[1]) + 0.5 * (hi[1] - lo[1]) * g3x[v],
-                                      0.5 * (lo[2] + hi[2]) + 0.5 * (hi[2] - lo[2]) * g3x[w]};
-                         double t[6];
-                         cuboid_demag_tensor(q, e, t);
-                         const double wt = g3w[u] * g3w[v] * g3w[w];
-                         for (int a = 0; a < 6; ++a) n[a] += wt * t[a];
-                       }
+                 [&](const Box&) {
+                   // Boxes have whole cells (uses_volume_shares) and no boundary correction.
+                   throw std::logic_error("uniform_demag_over_cell: a box has no volume-share cells");
                  },
                  [&](const Cylinder& c) {
                    const Vec3& p = cells.local_positions[i];

@@ -74,10 +74,10 @@ inline constexpr double kMinVolumeShareExtent = 2.0;
 // The demagnetising tensor of the uniformly magnetized shape, averaged over
 // cell i's part of it: H = -N M there for a body of uniform magnetization M
 // (body frame, six components xx, xy, xz, yy, yz, zz; trace 1). Exactly I/3
-// for a ball; for a box the closed-form cuboid tensor averaged over the cell's
-// box by 3x3x3 Gauss points; for a cylinder the field of its charged end
-// discs and side (one-dimensional quadratures) at 3 Gauss points along the
-// axis through the centroid of the cell's cross-section.
+// for a ball; for a cylinder the field of its charged end discs and side
+// (one-dimensional quadratures) at 3 Gauss points along the axis through the
+// centroid of the cell's cross-section. Boxes have no volume-share cells
+// (uses_volume_shares): std::logic_error.
 void uniform_demag_over_cell(const Shape& shape, const CellSet& cells, int i, double n[6]);
 
 }  // namespace odemag

@@ -3,7 +3,7 @@
 //
 // Inside a body two lattice cells couple through the mean over cube a of the
 // field of cube b, H_a = -N(d) mu_b / V (magnetics/model.cpp; N the Newell
-// tensor, magnetics/demag_tensor.h, d the offset of the lattice sites); between
+// tensor, magnetics/demag_tensor.h, d the offset of the cubes' centres); between
 // bodies the dense sums couple them as point dipoles, H_a = T(r) mu_b
 // (magnetics/kernels.h, r the offset of the cell points), 18% too strongly for
 // face neighbours: a chi = 1000 cube cut in two touching halves had a moment
@@ -11,15 +11,16 @@
 // tests/magnetics/lattice_near_field_test.cpp), and the halves did not converge
 // in 200 iterations. For cells i, j of two bodies A, B with parallel lattices (the
 // same spacing h, R_A^T R_B a signed permutation within the window w_a) this term
-// adds the difference for every pair whose sites are closer than kCutoffEnd h:
+// adds the difference for every pair whose points are closer than kCutoffEnd h:
 //
 //   H_i += K mu_j,  H_j += K mu_i,   U = -mu0 mu_i . K mu_j,   mu = M V (cell volume),
 //   K = w_a(c) w_r(|d|) [ (T_A(d) + T_B(d)) / 2 - T(r; s_ij) ],
 //   T_X(d) = -R_X N_s(R_X^T d) R_X^T / V,   V = sqrt(V_i V_j) (pair_volume),
 //
-// d = site_i - site_j and r = x_i - x_j (the same today: the cube of a
-// boundary cell is centred on its point, the centroid of its part, which puts
-// an end face's charge where the material is; coaxial cylinders, docs/model.md), T(r; s_ij) the dense kernel
+// d = r = x_i - x_j, the cell points (each cell's cube is centred on its point:
+// the lattice site of a whole cube, the centroid of its part of the body for a
+// boundary cell, which puts an end face's charge where the material is; coaxial
+// cylinders, docs/model.md), T(r; s_ij) the dense kernel
 // with the pair's contact distance, R_X the rotation of body X. So a pair couples
 // exactly as two cells of one body do, and cutting a box of whole cells into
 // touching pieces changes nothing but the pairs beyond the cutoff (for other
@@ -71,9 +72,9 @@
 // torque on the cubes' frames, -dU/dtheta of turning R_X alone,
 //   tau_X = -mu0 w_a w_r / 2 [ d x g_X + mu_i x T_X mu_j + mu_j x T_X mu_i ],
 // g_X = grad_d (mu_i . T_X mu_j); the alignment window gives body B
-// mu0 w_r w_a'(c) (dc/dtheta_B) (mu_i . K mu_j) / w_a and A the opposite; and the
-// backends apply a cell's force at its point x, while the site part F_d of it
-// acts at the site: (site - x) x F_d. The interface passes forces and fields
+// mu0 w_r w_a'(c) (dc/dtheta_B) (mu_i . K mu_j) / w_a and A the opposite. (The
+// cubes are centred on the cell points, where the backends apply the forces,
+// so the forces themselves add no torque about the points.) The interface passes forces and fields
 // per cell, so each body's sum tau is applied as the rigid distribution
 // F_c = (J^-1 tau) x (x_c - x_bar) over its cells (J = sum |x_c - x_bar|^2 I -
 // (x_c - x_bar)(x_c - x_bar)^T about their centroid x_bar): no net force,
@@ -85,8 +86,8 @@
 // about 10 us per pair, forces (the gradient, two frames) 7-20 us per pair on
 // the 2-core test machine; each field evaluation two 3 x 3 products per pair.
 //
-// Pair search (build): bodies first, by the bounding spheres of their lattice
-// sites; then the cells of each body within reach of the other's sphere; then
+// Pair search (build): bodies first, by the bounding spheres of their cell
+// points; then the cells of each body within reach of the other's sphere; then
 // those cell pairs: O(bodies^2 + cells of close bodies + their cell pairs), not
 // O(N^2) over a scene of separate bodies. Pairs are kept in a fixed order and
 // summed on one thread. The dense sums' responsive-responsive pairs are left
@@ -185,7 +186,7 @@ void rotate_symmetric(const Mat3& R, const double s[6], double out[6]) {
 }
 
 // The tensor of two aligned cubes of edge h acting on moments, H = D mu, at the
-// site offset d in their frame: D = -N_s(d) / h^3 (header comment), and, when
+// offset d of their centres in their frame: D = -N_s(d) / h^3 (header comment), and, when
 // dD is not null, its gradient dD[k] = dD / dd_k.
 void cube_pair_tensor(const double d[3], double h, double volume, double D[6], double (*dD)[6]) {
   double n[6], dn[3][6];
@@ -277,13 +278,12 @@ struct CellPair {
   double K[6];       // world
 };
 
-// A body's lattice sites, bounding sphere and the rigid distribution of a pure
-// torque over its cells: forces (J^-1 tau) x (x_c - centroid).
+// A body's bounding sphere about its cells' centroid and the rigid
+// distribution of a pure torque over its cells: forces (J^-1 tau) x (x_c - centroid).
 struct LatticeBody {
   bool eligible = false;
-  Vec3 centre;  // of the sites
-  double radius = 0.0;
   Vec3 centroid;  // of the cell points
+  double radius = 0.0;
   Eigen::Matrix3d J_inverse = Eigen::Matrix3d::Zero();
 };
 
@@ -293,7 +293,6 @@ class LatticeNearField final : public NearFieldTerm {
     links_.clear();
     pairs_.clear();
     bodies_.assign(model.body_count(), {});
-    site_.assign(model.cell_count(), {});
     // With point-dipole intra-body tensors (the paper's model) a body's own
     // cells couple as point dipoles too: nothing to correct.
     if (model.intra_body_tensor() != IntraBodyTensor::cell_average) return;
@@ -303,21 +302,13 @@ class LatticeNearField final : public NearFieldTerm {
       if (body.inert() || !state.active[b] || body.cells.spacing <= 0.0 || body.cell_count() < 3) continue;
       LatticeBody& lb = bodies_[b];
       const double h = body.cells.spacing;
-      for (int i = 0; i < body.cell_count(); ++i) {
-        const int c = body.first_cell + i;
-        // The cube's centre: its lattice site for a whole cube, the centroid
-        // of its part of the body for a boundary cell (magnetics/cells.h).
-        site_[c] = state.pose[b].position + state.pose[b].rotation * body.cells.local_positions[i];
-        lb.centre += site_[c];
-        lb.centroid += state.cell_position[c];
-      }
-      lb.centre = lb.centre / body.cell_count();
+      for (int i = 0; i < body.cell_count(); ++i) lb.centroid += state.cell_position[body.first_cell + i];
       lb.centroid = lb.centroid / body.cell_count();
       Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
       for (int i = 0; i < body.cell_count(); ++i) {
         const int c = body.first_cell + i;
-        lb.radius = std::max(lb.radius, norm(site_[c] - lb.centre));
         const Vec3 d = state.cell_position[c] - lb.centroid;
+        lb.radius = std::max(lb.radius, norm(d));
         const Eigen::Vector3d e(d.x, d.y, d.z);
         J += e.squaredNorm() * Eigen::Matrix3d::Identity() - e * e.transpose();
       }
@@ -350,8 +341,7 @@ class LatticeNearField final : public NearFieldTerm {
     for (const CellPair& p : pairs_) {
       const BodyLink& l = links_[p.link];
       const Vec3 mu_i = moment(model, state, p.i), mu_j = moment(model, state, p.j);
-      const Vec3 d = site_[p.i] - site_[p.j];
-      const Vec3 r = state.cell_position[p.i] - state.cell_position[p.j];
+      const Vec3 r = state.cell_position[p.i] - state.cell_position[p.j], &d = r;
       const double dn = norm(d);
       const Window wr = radial_window(dn, l.h);
       const double w = l.align.w * wr.w;
@@ -362,22 +352,20 @@ class LatticeNearField final : public NearFieldTerm {
       const double s = model.cell_contact_radius(p.i) + model.cell_contact_radius(p.j);
       const Vec3 Tk_mu_j = dipole_field(r, mu_j, s * s), Tk_mu_i = dipole_field(r, mu_i, s * s);
       const double phi0 = 0.5 * (A.phi + B.phi) - dot(mu_i, Tk_mu_j);
-      // F_i = mu0 grad (w phi0): the part through the site offset d and through r.
-      const Vec3 F_site = (kMu0 * l.align.w) * ((wr.dw * phi0 / dn) * d + (0.5 * wr.w) * (A.grad + B.grad));
+      // F_i = mu0 grad (w phi0): the part through the cubes' tensor (offset d) and
+      // through the dense kernel's (r).
+      const Vec3 F_cubes = (kMu0 * l.align.w) * ((wr.dw * phi0 / dn) * d + (0.5 * wr.w) * (A.grad + B.grad));
       const Vec3 F_points = -w * dipole_force(r, mu_j, mu_i, s * s);
-      force[p.i] += F_site + F_points;
-      force[p.j] -= F_site + F_points;
+      force[p.i] += F_cubes + F_points;
+      force[p.j] -= F_cubes + F_points;
       field[p.i] += w * (0.5 * (A.H_i + B.H_i) - Tk_mu_j);
       field[p.j] += w * (0.5 * (A.H_j + B.H_j) - Tk_mu_i);
-      // Pure torques (header comment): the frames', the alignment window's, and
-      // the site forces' lever arms from the cell points to the sites.
+      // Pure torques (header comment): the frames' and the alignment window's.
       body_torque[l.a] -= (0.5 * kMu0 * w) * (cross(d, A.grad) + cross(mu_i, A.H_i) + cross(mu_j, A.H_j));
       body_torque[l.b] -= (0.5 * kMu0 * w) * (cross(d, B.grad) + cross(mu_i, B.H_i) + cross(mu_j, B.H_j));
       const Vec3 tau_align = (kMu0 * wr.w * l.align.dw * phi0) * l.dc_dtheta_b;
       body_torque[l.b] += tau_align;
       body_torque[l.a] -= tau_align;
-      body_torque[l.a] += cross(site_[p.i] - state.cell_position[p.i], F_site);
-      body_torque[l.b] -= cross(site_[p.j] - state.cell_position[p.j], F_site);
     }
     for (int b = 0; b < model.body_count(); ++b) {
       const Vec3& tau = body_torque[b];
@@ -413,7 +401,7 @@ class LatticeNearField final : public NearFieldTerm {
     if (std::fabs(ha - hb) > kSpacingTolerance * std::max(ha, hb)) return;
     const double h = 0.5 * (ha + hb), cutoff = kCutoffEnd * h;
     const LatticeBody &la = bodies_[a], &lb = bodies_[b];
-    if (norm(la.centre - lb.centre) >= la.radius + lb.radius + cutoff) return;
+    if (norm(la.centroid - lb.centroid) >= la.radius + lb.radius + cutoff) return;
     // Alignment: Q = R_A^T R_B, P its nearest signed permutation, E = Q P^T.
     const Mat3& Ra = state.pose[a].rotation;
     const Mat3 Q = Ra.transposed() * state.pose[b].rotation;
@@ -440,7 +428,7 @@ class LatticeNearField final : public NearFieldTerm {
       std::vector<int> cells;
       for (int i = 0; i < body.cell_count(); ++i) {
         const int c = body.first_cell + i;
-        if (norm(site_[c] - other.centre) < other.radius + cutoff) cells.push_back(c);
+        if (norm(state.cell_position[c] - other.centroid) < other.radius + cutoff) cells.push_back(c);
       }
       return cells;
     };
@@ -449,7 +437,7 @@ class LatticeNearField final : public NearFieldTerm {
     const std::size_t first_pair = pairs_.size();
     for (int i : cells_a)
       for (int j : cells_b) {
-        const Vec3 d = site_[i] - site_[j];
+        const Vec3 d = state.cell_position[i] - state.cell_position[j];
         const Window wr = radial_window(norm(d), h);
         if (wr.w == 0.0) continue;
         CellPair p;
@@ -459,7 +447,7 @@ class LatticeNearField final : public NearFieldTerm {
         const FrameShare sb = frame_share(state.pose[b].rotation, d, h, volume, nullptr, nullptr);
         const double s = model.cell_contact_radius(i) + model.cell_contact_radius(j);
         double t[6];
-        dipole_tensor(state.cell_position[i] - state.cell_position[j], s * s, t);
+        dipole_tensor(d, s * s, t);
         for (int m = 0; m < 6; ++m) p.K[m] = link.align.w * wr.w * (0.5 * (sa.t[m] + sb.t[m]) - t[m]);
         pairs_.push_back(p);
       }
@@ -469,7 +457,6 @@ class LatticeNearField final : public NearFieldTerm {
   std::vector<BodyLink> links_;
   std::vector<CellPair> pairs_;
   std::vector<LatticeBody> bodies_;
-  std::vector<Vec3> site_;  // world lattice site per cell of an eligible body
 };
 
 }  // namespace

@@ -81,47 +81,57 @@ void place_cells(const MagneticModel& model, MagneticState& state) {
 
 namespace {
 
-// Body-frame moments and boundary-correction fields of body b's cells.
-void boundary_field_of_body(const MagneticModel& model, const MagneticState& state, int b,
-                            std::vector<Vec3>& mu, std::vector<Vec3>& dH) {
+// Calls visit(i, mu_i, dH_i) with the body-frame moment and boundary-correction
+// field of each of body b's cells; two passes over the cells (the uniform mode
+// needs every moment first), each moment computed afresh, so nothing is
+// allocated on this per-iteration path.
+template <class Visit>
+void visit_boundary_field(const MagneticModel& model, const MagneticState& state, int b,
+                          Visit&& visit) {
   const MagneticBody& body = model.body(b);
   const Mat3& R = state.pose[b].rotation;
   const int n = body.cell_count();
-  mu.resize(n);
-  dH.resize(n);
+  auto moment = [&](int i) {
+    return R.transpose_times(body.cells.volumes[i] * state.magnetization[body.first_cell + i]);
+  };
   Vec3 sum_pi, sum_beta;
   for (int i = 0; i < n; ++i) {
-    mu[i] = R.transpose_times(body.cells.volumes[i] * state.magnetization[body.first_cell + i]);
-    sum_pi += symmetric_times(&body.uniform_tensors[12u * i], mu[i]);
-    sum_beta += symmetric_times(&body.uniform_tensors[12u * i + 6], mu[i]);
+    const Vec3 mu = moment(i);
+    sum_pi += symmetric_times(&body.uniform_tensors[12u * i], mu);
+    sum_beta += symmetric_times(&body.uniform_tensors[12u * i + 6], mu);
   }
   const Vec3 u_pi = body.uniform_inverse[0] * sum_pi, u_beta = body.uniform_inverse[1] * sum_beta;
-  for (int i = 0; i < n; ++i)
-    dH[i] = symmetric_times(&body.self_tensors[6u * i], mu[i]) +
-            symmetric_times(&body.uniform_tensors[12u * i], u_pi) -
-            symmetric_times(&body.uniform_tensors[12u * i + 6], u_beta);
+  for (int i = 0; i < n; ++i) {
+    const Vec3 mu = moment(i);
+    visit(i, mu,
+          symmetric_times(&body.self_tensors[6u * i], mu) +
+              symmetric_times(&body.uniform_tensors[12u * i], u_pi) -
+              symmetric_times(&body.uniform_tensors[12u * i + 6], u_beta));
+  }
 }
 
 }  // namespace
 
-void add_boundary_field(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& H) {
-  std::vector<Vec3> mu, dH;
+void add_boundary_field(const MagneticModel& model, const MagneticState& state,
+                        std::vector<Vec3>& H) {
   for (int b = 0; b < model.body_count(); ++b) {
     const MagneticBody& body = model.body(b);
     if (body.self_tensors.empty() || !state.active[b]) continue;
-    boundary_field_of_body(model, state, b, mu, dH);
-    for (int i = 0; i < body.cell_count(); ++i) H[body.first_cell + i] += state.pose[b].rotation * dH[i];
+    const Mat3& R = state.pose[b].rotation;
+    visit_boundary_field(model, state, b, [&](int i, const Vec3&, const Vec3& dH) {
+      H[body.first_cell + i] += R * dH;
+    });
   }
 }
 
 double boundary_field_energy(const MagneticModel& model, const MagneticState& state) {
-  std::vector<Vec3> mu, dH;
   double e = 0.0;
   for (int b = 0; b < model.body_count(); ++b) {
     const MagneticBody& body = model.body(b);
     if (body.self_tensors.empty() || !state.active[b]) continue;
-    boundary_field_of_body(model, state, b, mu, dH);
-    for (int i = 0; i < body.cell_count(); ++i) e -= 0.5 * kMu0 * dot(mu[i], dH[i]);
+    visit_boundary_field(model, state, b, [&](int, const Vec3& mu, const Vec3& dH) {
+      e -= 0.5 * kMu0 * dot(mu, dH);
+    });
   }
   return e;
 }
@@ -143,7 +153,8 @@ Vec3 body_moment(const MagneticModel& model, const MagneticState& state, int b) 
     for (int i = 0; i < body.cell_count(); ++i) mu += state.magnetization[body.first_cell + i];
     return body.cells.cell_volume * mu;
   }
-  for (int i = 0; i < body.cell_count(); ++i) mu += body.cells.volumes[i] * state.magnetization[body.first_cell + i];
+  for (int i = 0; i < body.cell_count(); ++i)
+    mu += body.cells.volumes[i] * state.magnetization[body.first_cell + i];
   return mu;
 }
 

@@ -1017,10 +1017,52 @@ SceneDescription read_scene(const SceneReader& r, const json& root) {
   return std::move(t.scene);
 }
 
+// A target as the loader starts from when an object's keys are read: the
+// description structs' default values (the references of body and event
+// targets bound to an empty scene).
+template <class T>
+struct FreshTarget {
+  T target{};
+};
+template <>
+struct FreshTarget<BodyTarget> {
+  SceneDescription scene;
+  BodyIndex index;
+  BodyTarget target{{}, scene, index};
+};
+template <>
+struct FreshTarget<EventTarget> {
+  SceneDescription scene;
+  BodyIndex index;
+  EventTarget target{{}, scene, index};
+};
+
+// A slot's value as JSON text; "" for an empty optional.
+std::string json_text(const Slot& slot) {
+  return std::visit(
+      [](auto* value) -> std::string {
+        using V = std::remove_pointer_t<decltype(value)>;
+        if constexpr (std::is_same_v<V, Vec3>) {
+          return json::array({value->x, value->y, value->z}).dump();
+        } else if constexpr (std::is_same_v<V, Quaternion>) {
+          return json::array({value->w, value->x, value->y, value->z}).dump();
+        } else if constexpr (std::is_same_v<V, std::optional<double>> ||
+                             std::is_same_v<V, std::optional<std::array<double, 3>>>) {
+          return *value ? json(**value).dump() : "";
+        } else {
+          return json(*value).dump();
+        }
+      },
+      slot);
+}
+
 template <class T>
 void add_key_docs(std::vector<SceneKeyDoc>& docs, const std::string& section, const KeyTable<T>& table) {
-  for (const KeyRule<T>& rule : table)
-    docs.push_back({section, rule.name, rule.doc.type, rule.doc.unit, rule.doc.fallback, rule.required});
+  for (const KeyRule<T>& rule : table) {
+    FreshTarget<T> fresh;
+    docs.push_back({section, rule.name, rule.doc.type, rule.doc.unit, rule.doc.fallback, rule.required,
+                    rule.slot ? json_text(rule.slot(fresh.target)) : ""});
+  }
 }
 
 }  // namespace

@@ -179,6 +179,10 @@ struct SceneKeyDoc {
   std::string unit;           // the docs' unit column; "" where empty or the table has none
   std::string default_value;  // the docs' default column ("`0`", "**required**", ...)
   bool required = false;
+  // A plain key's value before the file sets it, from the description
+  // structs, as JSON text ("0", "[0.0,0.0,-9.81]", "\"\""); "" for keys read
+  // by their own code and for unset optionals.
+  std::string struct_default;
 };
 
 // Every key of every scene object, table by table, in the order the loader

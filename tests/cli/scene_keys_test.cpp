@@ -1,6 +1,7 @@
 // docs/scene-format.md against the loader's key tables (scene_key_docs): every
 // key table of the docs lists exactly the keys of its object, in the loader's
-// order, with the loader's type, unit and default; the timeline's action table
+// order, with the loader's type, unit and default, and each default is the value the
+// description structs start from; the timeline's action table
 // lists each action's keys; the objects documented in prose name all their keys.
 #include <gtest/gtest.h>
 
@@ -12,6 +13,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "engine/scene/scene.h"
 
@@ -156,6 +159,27 @@ TEST(SceneKeys, KeyTablesMatchTheLoader) {
       EXPECT_EQ(k->required, k->default_value == "**required**") << "required of " << name;
     }
   }
+}
+
+// The docs' default of every plain key is the value the description structs
+// start from: a key left out of a file gets what the docs say. Numbers are
+// compared as parsed doubles, so "`1e-6`" matches 1e-06; a default the docs
+// write as a bare word (`auto`) matches the string "auto".
+TEST(SceneKeys, DocumentedDefaultsAreTheStructDefaults) {
+  int compared = 0;
+  for (const SceneKeyDoc& k : odemag::scene_key_docs()) {
+    const std::string& doc = k.default_value;
+    if (k.struct_default.empty() || doc.size() < 2 || doc.front() != '`' || doc.back() != '`') continue;
+    const std::string text = unquote(doc);
+    const nlohmann::json actual = nlohmann::json::parse(k.struct_default);
+    nlohmann::json documented = nlohmann::json::parse(text, nullptr, false);
+    if (documented.is_discarded()) documented = text;  // a bare word
+    // JSON integers and doubles compare by value; arrays element by element.
+    EXPECT_EQ(documented, actual) << k.section << "." << k.key << ": the docs say " << doc
+                                  << ", the structs start from " << k.struct_default;
+    ++compared;
+  }
+  EXPECT_GT(compared, 40) << "too few defaults compared: the docs' format changed?";
 }
 
 TEST(SceneKeys, TimelineActionsMatchTheLoader) {
