@@ -181,62 +181,54 @@ Reaction solve_pair(const PairType& type, double x) {
   return out;
 }
 
-// Natural cubic spline through (x_i, y_i) on a non-uniform grid.
-struct Spline {
-  std::vector<double> x, y, y2;
-  void fit() {
-    const int n = static_cast<int>(x.size());
-    y2.assign(n, 0.0);
-    std::vector<double> u(n, 0.0);
-    for (int i = 1; i < n - 1; ++i) {
-      const double sig = (x[i] - x[i - 1]) / (x[i + 1] - x[i - 1]);
-      const double p = sig * y2[i - 1] + 2.0;
-      y2[i] = (sig - 1.0) / p;
-      const double slope = (y[i + 1] - y[i]) / (x[i + 1] - x[i]) - (y[i] - y[i - 1]) / (x[i] - x[i - 1]);
-      u[i] = (6.0 * slope / (x[i + 1] - x[i - 1]) - sig * u[i - 1]) / p;
-    }
-    for (int i = n - 2; i >= 0; --i) y2[i] = y2[i] * y2[i + 1] + u[i];
+// Natural cubic spline through (x_i, y_i) on a non-uniform grid: its second
+// derivatives y2 at the knots.
+std::vector<double> spline_second_derivatives(const std::vector<double>& x, const std::vector<double>& y) {
+  const int n = static_cast<int>(x.size());
+  std::vector<double> y2(n, 0.0), u(n, 0.0);
+  for (int i = 1; i < n - 1; ++i) {
+    const double sig = (x[i] - x[i - 1]) / (x[i + 1] - x[i - 1]);
+    const double p = sig * y2[i - 1] + 2.0;
+    y2[i] = (sig - 1.0) / p;
+    const double slope = (y[i + 1] - y[i]) / (x[i + 1] - x[i]) - (y[i] - y[i - 1]) / (x[i] - x[i - 1]);
+    u[i] = (6.0 * slope / (x[i + 1] - x[i - 1]) - sig * u[i - 1]) / p;
   }
-  // Value and derivative at t in [x.front(), x.back()].
-  void eval(double t, double& value, double& slope) const {
-    const int i = std::clamp(static_cast<int>(std::upper_bound(x.begin(), x.end(), t) - x.begin()) - 1, 0,
-                             static_cast<int>(x.size()) - 2);
-    const double h = x[i + 1] - x[i], a = (x[i + 1] - t) / h, b = (t - x[i]) / h;
-    value = a * y[i] + b * y[i + 1] + ((a * a * a - a) * y2[i] + (b * b * b - b) * y2[i + 1]) * h * h / 6.0;
-    slope = (y[i + 1] - y[i]) / h + (-(3 * a * a - 1) * y2[i] + (3 * b * b - 1) * y2[i + 1]) * h / 6.0;
-  }
-};
+  for (int i = n - 2; i >= 0; --i) y2[i] = y2[i] * y2[i + 1] + u[i];
+  return y2;
+}
 
 class PairTable {
  public:
-  explicit PairTable(const PairType& type) {
-    for (auto& s : splines_) s.x.resize(kKnots), s.y.resize(kKnots);
-    for (auto& s : contact_) s.x.resize(kKnots), s.y.resize(kKnots);
+  // The tabulated series: the six k d^3 ([sector][aa, ab, bb]), then the four
+  // contact coefficients (Reaction), all on the same knots.
+  static constexpr int kSeries = 10;
+
+  explicit PairTable(const PairType& type) : x_(kKnots), y_(kKnots * kSeries), y2_(kKnots * kSeries) {
+    std::vector<std::vector<double>> series(kSeries, std::vector<double>(kKnots));
     for (int i = 0; i < kKnots; ++i) {
-      const double t = static_cast<double>(i) / (kKnots - 1);
-      const double x = 1.0 + (kCutoff - 1.0) * t * t;  // clustered at contact
-      const Reaction r = solve_pair(type, x);
-      for (int s = 0; s < 6; ++s) {
-        splines_[s].x[i] = x;
-        splines_[s].y[i] = r.k[s / 3][s % 3];
-      }
-      for (int s = 0; s < 4; ++s) {
-        contact_[s].x[i] = x;
-        contact_[s].y[i] = r.contact[s];
+      x_[i] = knot(i);
+      const Reaction r = solve_pair(type, x_[i]);
+      for (int s = 0; s < 6; ++s) series[s][i] = r.k[s / 3][s % 3];
+      for (int s = 0; s < 4; ++s) series[6 + s][i] = r.contact[s];
+    }
+    for (int s = 0; s < kSeries; ++s) {
+      const std::vector<double> y2 = spline_second_derivatives(x_, series[s]);
+      for (int i = 0; i < kKnots; ++i) {
+        y_[i * kSeries + s] = series[s][i];
+        y2_[i * kSeries + s] = y2[i];
       }
     }
-    for (auto& s : splines_) s.fit();
-    for (auto& s : contact_) s.fit();
   }
 
   // Contact-point magnetization coefficients (1/m^3) at centre distance d:
   // M_hi along u at a = c[0] (u.p_a) + c[1] (u.p_b), at b = c[2] (u.p_a) + c[3] (u.p_b).
   void contact(double d, double reach, double c[4]) const {
-    const double x = std::clamp(d / reach, 1.0, kCutoff), d3 = std::pow(x * reach, 3);
+    const double x = std::clamp(d / reach, 1.0, kCutoff), xr = x * reach, inv_d3 = 1.0 / (xr * xr * xr);
+    const Weights w = weights(x);
     for (int s = 0; s < 4; ++s) {
       double v, slope;
-      contact_[s].eval(x, v, slope);
-      c[s] = v / d3;
+      series_at(w, 6 + s, v, slope);
+      c[s] = v * inv_d3;
     }
   }
   // K (1/m^3) and dK/dd (1/m^4) at centre distance d of a pair with
@@ -273,19 +265,53 @@ class PairTable {
       w = 1.0 - u * u * u * (10.0 - 15.0 * u + 6.0 * u * u);
       dw = -30.0 * u * u * (1.0 - u) * (1.0 - u) / (kCutoff - kTaperStart);
     }
-    const double d3 = d * d * d;
+    const double inv_d = 1.0 / d, inv_d3 = inv_d * inv_d * inv_d, inv_reach_d3 = inv_d3 / reach;
+    const Weights at = weights(x);
     for (int s = 0; s < 6; ++s) {
       double k, dk;
-      splines_[s].eval(x, k, dk);
+      series_at(at, s, k, dk);
       // K = w k / d^3, d/dd = (w dk/dx + dw/dx k) / (reach d^3) - 3 w k / d^4.
-      K[s] = w * k / d3;
-      dK[s] = (w * dk + dw * k) / (reach * d3) - 3.0 * K[s] / d;
+      K[s] = w * k * inv_d3;
+      dK[s] = (w * dk + dw * k) * inv_reach_d3 - 3.0 * K[s] * inv_d;
     }
   }
 
  private:
-  std::array<Spline, 6> splines_;
-  std::array<Spline, 4> contact_;
+  // Knot i: x = 1 + (kCutoff - 1) t^2, t = i / (kKnots - 1), clustered at contact.
+  static double knot(int i) {
+    const double t = static_cast<double>(i) / (kKnots - 1);
+    return 1.0 + (kCutoff - 1.0) * t * t;
+  }
+  // Where x in [1, kCutoff] lies among the knots, and the cubic spline's
+  // weights there: one search for all the series (they share the knots).
+  struct Weights {
+    int i = 0;
+    double h = 0.0, a = 0.0, b = 0.0;
+  };
+  Weights weights(double x) const {
+    // The knot formula inverted, then a step either way for rounding.
+    int i = static_cast<int>(std::sqrt(std::max(0.0, (x - 1.0) / (kCutoff - 1.0))) * (kKnots - 1));
+    i = std::clamp(i, 0, kKnots - 2);
+    while (i > 0 && x < x_[i]) --i;
+    while (i < kKnots - 2 && x >= x_[i + 1]) ++i;
+    Weights w;
+    w.i = i;
+    w.h = x_[i + 1] - x_[i];
+    w.a = (x_[i + 1] - x) / w.h;
+    w.b = (x - x_[i]) / w.h;
+    return w;
+  }
+  // Series s's value and derivative at the point of w.
+  void series_at(const Weights& w, int s, double& value, double& slope) const {
+    const double y0 = y_[w.i * kSeries + s], y1 = y_[(w.i + 1) * kSeries + s];
+    const double c0 = y2_[w.i * kSeries + s], c1 = y2_[(w.i + 1) * kSeries + s];
+    const double a = w.a, b = w.b, h = w.h;
+    value = a * y0 + b * y1 + ((a * a * a - a) * c0 + (b * b * b - b) * c1) * h * h / 6.0;
+    slope = (y1 - y0) / h + (-(3 * a * a - 1) * c0 + (3 * b * b - 1) * c1) * h / 6.0;
+  }
+
+  std::vector<double> x_;        // knots
+  std::vector<double> y_, y2_;   // per knot, per series: values and second derivatives
 };
 
 // One table per pair type, shared by every model of the process.
@@ -299,17 +325,22 @@ std::shared_ptr<const PairTable> pair_table(const PairType& type) {
 }
 
 // How a one-cell body takes part: radius and susceptibility of its higher
-// orders (negative: rigid).
+// orders (negative: rigid), and what the per-iteration sums read of its body.
 struct SphereCell {
   int cell = -1;
   double radius = 0.0;
   double chi = -1.0;
+  double volume = 0.0;       // of the cell: the dipole is volume * M
+  bool responsive = false;
+  bool saturates = false;    // a soft sphere: saturation_factor limits it at Ms
+  double Ms = 0.0;
+  int type = 0;              // index of its (radius, chi) among the spheres'
   bool multipoles() const { return chi >= 0.0; }
 };
 
 struct SpherePair {
   int a = -1, b = -1;                // cells
-  int body_a = -1, body_b = -1;
+  int sa = -1, sb = -1;              // their SphereCells
   Vec3 u;                            // (x_b - x_a) / d
   double d = 0.0;
   double k[6] = {};                  // K entries, 1/m^3: [par aa, ab, bb, perp aa, ab, bb]
@@ -317,85 +348,118 @@ struct SpherePair {
   double contact[4] = {};            // PairTable::contact
 };
 
+// Each sphere's dipole p = V M and room below saturation max(0, Ms - |M|) at
+// the current magnetizations: computed once per sum, read by every pair.
+struct SphereMoments {
+  std::vector<Vec3> dipole;
+  std::vector<double> room;
+};
+
 class SphereNearField final : public NearFieldTerm {
  public:
   void build(const MagneticModel& model, const MagneticState& state) override {
     pairs_.clear();
     cells_.clear();
+    std::map<std::pair<double, double>, int> types;  // (radius, chi) -> type
     for (int bi = 0; bi < model.body_count(); ++bi) {
       const MagneticBody& body = model.body(bi);
       if (body.inert() || !state.active[bi] || body.cell_count() != 1 || body.cells.spacing > 0.0) continue;
       SphereCell s;
       s.cell = body.first_cell;
       s.radius = body.cells.contact_radius;
-      if (std::holds_alternative<Sphere>(body.shape)) {
+      const bool sphere = std::holds_alternative<Sphere>(body.shape);
+      if (sphere) {
         if (body.kind == CellKind::soft) s.chi = std::get<SoftMaterial>(body.material).susceptibility;
         if (body.kind == CellKind::recoil_permanent) s.chi = body.recoil;
       }
+      s.volume = body.cells.cell_volume;
+      s.responsive = body.responsive();
+      s.saturates = sphere && body.kind == CellKind::soft;
+      s.Ms = body.soft.Ms;
+      s.type = types.emplace(std::make_pair(s.radius, s.chi), static_cast<int>(types.size())).first->second;
       cells_.push_back(s);
     }
+    std::map<std::pair<int, int>, std::shared_ptr<const PairTable>> tables;  // by (type a, type b)
+    std::pair<int, int> last_types{-1, -1};
+    const PairTable* table = nullptr;
+    // Every pair of spheres (a heap is compact: buckets of the cutoff's width
+    // would hold most of it, so they would prune little).
     const int n = static_cast<int>(cells_.size());
-    for (int i = 0; i < n; ++i)
+    for (int i = 0; i < n; ++i) {
       for (int j = i + 1; j < n; ++j) {
         const SphereCell &ca = cells_[i], &cb = cells_[j];
         if (!ca.multipoles() && !cb.multipoles()) continue;
         // Without mutual induction only fixed magnets induce (one partner fixed).
-        if (!mutual_induction_ && model.body(model.cell_body(ca.cell)).responsive() &&
-            model.body(model.cell_body(cb.cell)).responsive())
-          continue;
+        if (!mutual_induction_ && ca.responsive && cb.responsive) continue;
         const double reach = ca.radius + cb.radius;
         const Vec3 r = state.cell_position[cb.cell] - state.cell_position[ca.cell];
         const double d2 = dot(r, r);
         if (d2 >= kCutoff * kCutoff * reach * reach) continue;
         SpherePair p;
         p.a = ca.cell, p.b = cb.cell;
-        p.body_a = model.cell_body(p.a), p.body_b = model.cell_body(p.b);
+        p.sa = i, p.sb = j;
         p.d = std::sqrt(d2);
         // Coincident centres: any axis (the functions are constant there).
         p.u = p.d > 0.0 ? r / p.d : Vec3{0.0, 0.0, 1.0};
-        const auto table = pair_table({ca.radius / reach, ca.chi, cb.chi});
+        if (ca.type != last_types.first || cb.type != last_types.second) {  // most pairs repeat the last type
+          last_types = {ca.type, cb.type};
+          auto& t = tables[last_types];
+          if (!t) t = pair_table({ca.radius / reach, ca.chi, cb.chi});
+          table = t.get();
+        }
         table->eval(p.d, reach, p.k, p.dk);
         table->contact(p.d, reach, p.contact);
         pairs_.push_back(p);
       }
+    }
   }
 
   void add_field(const MagneticModel& model, const MagneticState& state, NearFieldSources sources,
                  std::vector<Vec3>& H) const override {
+    (void)model;
+    const SphereMoments& m = moments(state);
+    const bool responsive_sources = sources == NearFieldSources::responsive;
     for (const SpherePair& p : pairs_) {
-      const double sigma = saturation_factor(model, state, p);
-      const Vec3 pa = dipole(model, state, p.a), pb = dipole(model, state, p.b);
-      const bool use_a = source_matches(model, p.body_a, sources), use_b = source_matches(model, p.body_b, sources);
-      const Vec3 za = use_a ? pa : Vec3{}, zb = use_b ? pb : Vec3{};
-      if (model.body(p.body_a).responsive())
-        H[p.a] += sigma * (apply(p, 0, za) + apply(p, 1, zb));
-      if (model.body(p.body_b).responsive())
-        H[p.b] += sigma * (apply(p, 1, za) + apply(p, 2, zb));
+      const SphereCell &ca = cells_[p.sa], &cb = cells_[p.sb];
+      const double sigma = saturation_factor(m, p);
+      const Vec3 za = ca.responsive == responsive_sources ? m.dipole[p.sa] : Vec3{};
+      const Vec3 zb = cb.responsive == responsive_sources ? m.dipole[p.sb] : Vec3{};
+      Vec3 Ha, Hb;
+      apply(p, za, zb, Ha, Hb);
+      if (ca.responsive) H[p.a] += sigma * Ha;
+      if (cb.responsive) H[p.b] += sigma * Hb;
     }
   }
 
   void add_forces(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& force,
                   std::vector<Vec3>& field) const override {
+    (void)model;
+    const SphereMoments& m = moments(state);
     for (const SpherePair& p : pairs_) {
-      const double sigma = saturation_factor(model, state, p);
-      const Vec3 pa = dipole(model, state, p.a), pb = dipole(model, state, p.b);
+      const double sigma = saturation_factor(m, p);
+      const Vec3 &pa = m.dipole[p.sa], &pb = m.dipole[p.sb];
       // F_b = +mu0/2 sigma grad_r (sum_xy p_x . K_xy p_y), F_a = -F_b.
       const Vec3 g = gradient(p, 0, pa, pa) + 2.0 * gradient(p, 1, pa, pb) + gradient(p, 2, pb, pb);
       const Vec3 Fb = 0.5 * kMu0 * sigma * g;
       force[p.b] += Fb;
       force[p.a] -= Fb;
-      field[p.a] += sigma * (apply(p, 0, pa) + apply(p, 1, pb));
-      field[p.b] += sigma * (apply(p, 1, pa) + apply(p, 2, pb));
+      Vec3 Ha, Hb;
+      apply(p, pa, pb, Ha, Hb);
+      field[p.a] += sigma * Ha;
+      field[p.b] += sigma * Hb;
     }
   }
 
   double energy(const MagneticModel& model, const MagneticState& state) const override {
+    (void)model;
+    const SphereMoments& m = moments(state);
     double e = 0.0;
     for (const SpherePair& p : pairs_) {
-      const double sigma = saturation_factor(model, state, p);
-      const Vec3 pa = dipole(model, state, p.a), pb = dipole(model, state, p.b);
-      e -= 0.5 * kMu0 * sigma *
-           (dot(pa, apply(p, 0, pa)) + 2.0 * dot(pa, apply(p, 1, pb)) + dot(pb, apply(p, 2, pb)));
+      const double sigma = saturation_factor(m, p);
+      const Vec3 &pa = m.dipole[p.sa], &pb = m.dipole[p.sb];
+      Vec3 Ha, Hb;
+      apply(p, pa, pb, Ha, Hb);
+      e -= 0.5 * kMu0 * sigma * (dot(pa, Ha) + dot(pb, Hb));
     }
     return e;
   }
@@ -403,16 +467,25 @@ class SphereNearField final : public NearFieldTerm {
   int pair_count() const override { return static_cast<int>(pairs_.size()); }
 
  private:
-  static Vec3 dipole(const MagneticModel& model, const MagneticState& state, int c) {
-    return model.body(model.cell_body(c)).cells.cell_volume * state.magnetization[c];
+  const SphereMoments& moments(const MagneticState& state) const {
+    const size_t n = cells_.size();
+    moments_.dipole.resize(n);
+    moments_.room.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      const SphereCell& c = cells_[i];
+      const Vec3& M = state.magnetization[c.cell];
+      moments_.dipole[i] = c.volume * M;
+      moments_.room[i] = c.saturates ? std::max(0.0, c.Ms - norm(M)) : 0.0;
+    }
+    return moments_;
   }
-  static bool source_matches(const MagneticModel& model, int body, NearFieldSources sources) {
-    return model.body(body).responsive() == (sources == NearFieldSources::responsive);
-  }
-  // K_xy p for block xy = 0 (aa), 1 (ab), 2 (bb).
-  static Vec3 apply(const SpherePair& p, int xy, const Vec3& v) {
-    const double par = p.k[xy], perp = p.k[3 + xy];
-    return perp * v + ((par - perp) * dot(p.u, v)) * p.u;
+  // The pair's fields from dipoles pa, pb: H_a = K_aa pa + K_ab pb and
+  // H_b = K_ab pa + K_bb pb, each K_xy v = perp v + (par - perp)(u . v) u.
+  static void apply(const SpherePair& p, const Vec3& pa, const Vec3& pb, Vec3& Ha, Vec3& Hb) {
+    const double ua = dot(p.u, pa), ub = dot(p.u, pb);
+    const double d_aa = p.k[0] - p.k[3], d_ab = p.k[1] - p.k[4], d_bb = p.k[2] - p.k[5];
+    Ha = p.k[3] * pa + p.k[4] * pb + (d_aa * ua + d_ab * ub) * p.u;
+    Hb = p.k[4] * pa + p.k[5] * pb + (d_ab * ua + d_bb * ub) * p.u;
   }
   // grad_r of s . K_xy(r) t, r = x_b - x_a.
   static Vec3 gradient(const SpherePair& p, int xy, const Vec3& s, const Vec3& t) {
@@ -426,16 +499,14 @@ class SphereNearField final : public NearFieldTerm {
   // add M_hi (along u) to a soft sphere's magnetization M at its contact
   // point; where |M| + |M_hi| would pass Ms they are scaled by
   // sigma = (Ms - |M|) / |M_hi|, the smallest over the pair's soft spheres.
-  double saturation_factor(const MagneticModel& model, const MagneticState& state, const SpherePair& p) const {
-    const Vec3 pa = dipole(model, state, p.a), pb = dipole(model, state, p.b);
-    const double ua = dot(p.u, pa), ub = dot(p.u, pb);
+  double saturation_factor(const SphereMoments& m, const SpherePair& p) const {
+    const double ua = dot(p.u, m.dipole[p.sa]), ub = dot(p.u, m.dipole[p.sb]);
     double sigma = 1.0;
     for (int side = 0; side < 2; ++side) {
-      const int c = side == 0 ? p.a : p.b;
-      const MagneticBody& body = model.body(model.cell_body(c));
-      if (body.kind != CellKind::soft || !std::holds_alternative<Sphere>(body.shape)) continue;
+      const int s = side == 0 ? p.sa : p.sb;
+      if (!cells_[s].saturates) continue;
       const double M_hi = std::fabs(p.contact[2 * side] * ua + p.contact[2 * side + 1] * ub);
-      const double room = std::max(0.0, body.soft.Ms - norm(state.magnetization[c]));
+      const double room = m.room[s];
       if (M_hi > room) sigma = std::min(sigma, room / M_hi);
     }
     return sigma;
@@ -443,6 +514,7 @@ class SphereNearField final : public NearFieldTerm {
 
   std::vector<SphereCell> cells_;
   std::vector<SpherePair> pairs_;
+  mutable SphereMoments moments_;  // scratch of the sums (the backends call them from one thread)
 };
 
 }  // namespace

@@ -17,6 +17,15 @@
 // the higher multipoles of one-cell spheres and the cell-averaged coupling
 // of aligned lattices between bodies, docs/model.md "The near field"): every
 // pinned scene has close ball pairs or touching lattice bodies.
+//
+// Re-pinned (stop 13) for the faster sphere near field (one knot search for
+// the ten tabulated series, reciprocals for divisions, a pair's two fields in
+// one pass; magnetics/sphere_near_field.cpp): the same formulas in another
+// order, so rounding differs; `odemag solve` of the paper scenes agrees with
+// the previous build to within the relaxation tolerance (largest relative
+// change of a body's moment or force 7e-6 at tolerance 1e-4, crane_small),
+// and the differences grow over the scenes' contact dynamics. The iron
+// plate, without one-cell sphere pairs, kept its hash.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -77,10 +86,10 @@ struct Case {
 };
 
 const Case kCases[] = {
-    {"ball_chain", 1.5, 0x35735c4d0141f98aULL},
+    {"ball_chain", 1.5, 0x5d2d2ffcca7062bbULL},
     {"iron_plate", 1.7, 0xe4aac92123770948ULL},
-    {"thin_iron_plate", 1.0, 0xe147c7be557853f3ULL},
-    {"nail_and_balls", 3.2, 0xed90b9774570b968ULL},
+    {"thin_iron_plate", 1.0, 0xe0e01d51f85588d8ULL},
+    {"nail_and_balls", 3.2, 0x7cc99497aee76426ULL},
 };
 
 // Set by tests/engine/CMakeLists.txt for a Release build with
