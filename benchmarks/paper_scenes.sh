@@ -3,9 +3,9 @@
 # time T_m and the rigid time T_r (median, 90th percentile), cell count and
 # outer relaxation iterations, next to the paper's numbers (docs/benchmarks.md).
 #
-#   benchmarks/paper_scenes.sh [--quick] [--odemag PATH] [--threads N]
-#                              [--steps N] [--scenes "ball_chain crane ..."]
-#                              [--out DIR]
+#   benchmarks/paper_scenes.sh [--quick] [--odemag PATH] [--before PATH]
+#                              [--threads N] [--steps N]
+#                              [--scenes "ball_chain crane ..."] [--out DIR]
 #
 # Writes DIR/paper_scenes.csv and DIR/paper_scenes.md (DIR defaults to
 # benchmarks/results). Without --odemag it builds build-bench/bin/odemag first
@@ -13,21 +13,26 @@
 # duration (the paper's Delta t is each scene's time_step), frames off;
 # --steps N runs N rigid steps of each scene instead, --quick runs the crane
 # for 1 s (1000 steps: the descent onto the heap and the first grip) instead
-# of 5 s.
+# of 5 s. --before PATH: an odemag program of an earlier version, run on
+# each scene just before the current one (same machine, same conditions);
+# the tables then give its T_m and T_r beside the current ones and their
+# ratio (before / current, above 1: the current version is faster).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 odemag=""
+before=""
 threads=2
 quick=0
 steps=""
 out="$root/benchmarks/results"
 scenes="ball_chain wood_plate iron_plate thin_iron_plate thick_iron_plate nail_and_balls crane"
 
-usage() { sed -n '2,16p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,20p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --odemag) odemag=$2; shift 2 ;;
+    --before) before=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
     --quick) quick=1; shift ;;
     --steps) steps=$2; shift 2 ;;
@@ -47,6 +52,7 @@ if [ -z "$odemag" ]; then
   odemag="$build/bin/odemag"
 fi
 [ -x "$odemag" ] || { echo "paper_scenes.sh: $odemag is not an executable" >&2; exit 2; }
+[ -z "$before" ] || [ -x "$before" ] || { echo "paper_scenes.sh: $before is not an executable" >&2; exit 2; }
 
 # Two OpenMP threads (the VM has two cores) and passive waiting: on a machine
 # shared with other jobs, spinning OpenMP barriers made small two-thread runs
@@ -71,16 +77,21 @@ for scene in $scenes; do
   # Wall, user and system seconds of the run: CPU seconds per wall second
   # below the thread count mean the machine was shared (or one thread idled).
   TIMEFORMAT='%R %U %S'
+  if [ -n "$before" ]; then
+    { time "$before" run "$file" --out "$work/before/$scene" --frames no --quiet yes --backend cpu \
+        --threads "$threads" "${args[@]}" 2>&3; } 3>&2 2>"$work/$scene.before.time"
+    echo "paper_scenes.sh: $scene (before) done in $(cut -d' ' -f1 "$work/$scene.before.time") s" >&2
+  fi
   { time "$odemag" run "$file" --out "$work/$scene" --frames no --quiet yes --backend cpu \
       --threads "$threads" "${args[@]}" 2>&3; } 3>&2 2>"$work/$scene.time"
   echo "paper_scenes.sh: $scene done in $(cut -d' ' -f1 "$work/$scene.time") s" >&2
 done
 
-python3 - "$work" "$out" "$threads" "$quick" "$steps" "$(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)" $scenes <<'EOF'
+python3 - "$work" "$out" "$threads" "$quick" "$steps" "$(git -C "$root" describe --always --dirty 2>/dev/null || echo unknown)" "${before:-}" $scenes <<'EOF'
 import json, os, sys
 
-work, out, threads, quick, steps, commit = sys.argv[1:7]
-scenes = sys.argv[7:]
+work, out, threads, quick, steps, commit, before = sys.argv[1:8]
+scenes = sys.argv[8:]
 
 # Paper Table 1 (Kim, Park & Han 2018): cells, Delta t, T_m, T_r in ms; CUDA
 # magnetics on a GeForce GTX 780, Bullet on an Intel Core i7-4770 3.40 GHz.
@@ -109,7 +120,9 @@ columns = ["scene", "cells", "responsive_cells", "dt_ms", "steps", "substeps_mea
            "tm_median_ms", "tm_p90_ms", "tm_mean_ms", "tr_median_ms", "tr_p90_ms", "tr_mean_ms",
            "iterations_mean", "iterations_max", "steps_not_converged", "wall_s", "cpu_per_wall",
            "paper_cells", "paper_dt_ms", "paper_tm_ms", "paper_tr_ms",
-           "ratio_tm_paper_over_ours", "ratio_tr_paper_over_ours", "machine"]
+           "ratio_tm_paper_over_ours", "ratio_tr_paper_over_ours",
+           "before_tm_mean_ms", "before_tr_mean_ms", "before_iterations_mean", "before_substeps_mean",
+           "ratio_tm_before_over_ours", "ratio_tr_before_over_ours", "machine"]
 rows = []
 for scene in scenes:
     s = json.load(open(os.path.join(work, scene, "summary.json")))
@@ -130,6 +143,14 @@ for scene in scenes:
         "ratio_tr_paper_over_ours": ratio(p[4], tr.get("median")),
         "machine": machine, "_title": p[0],
     })
+    b = json.load(open(os.path.join(work, "before", scene, "summary.json"))) if before else None
+    r = rows[-1]
+    r["before_tm_mean_ms"] = b["magnetic_ms"].get("mean") if b else None
+    r["before_tr_mean_ms"] = b["rigid_ms"].get("mean") if b else None
+    r["before_iterations_mean"] = b["iterations"].get("mean") if b else None
+    r["before_substeps_mean"] = b["substeps"].get("mean") if b else None
+    r["ratio_tm_before_over_ours"] = ratio(r["before_tm_mean_ms"], tm.get("mean"))
+    r["ratio_tr_before_over_ours"] = ratio(r["before_tr_mean_ms"], tr.get("mean"))
 
 def fmt(v, digits=3):
     if v is None:
@@ -161,5 +182,17 @@ with open(os.path.join(out, "paper_scenes.md"), "w") as f:
             fmt(r["tr_p90_ms"]), fmt(r["tr_mean_ms"]), fmt(r["iterations_mean"]), fmt(r["paper_cells"]),
             fmt(r["paper_tm_ms"]), fmt(r["paper_tr_ms"]), fmt(r["ratio_tm_paper_over_ours"], 2),
             fmt(r["ratio_tr_paper_over_ours"], 2), fmt(r["cpu_per_wall"], 2)]) + " |\n")
+    if before:
+        f.write(f"\nBefore and after, each scene run with the earlier program ({before}) just before the "
+                "current one: means per rigid step in ms; ratio = before / after (above 1: faster now).\n\n")
+        f.write("| scene | T_m before | T_m after | ratio T_m | T_r before | T_r after | ratio T_r | "
+                "iterations before | iterations after | substeps before | substeps after |\n")
+        f.write("|---|---|---|---|---|---|---|---|---|---|---|\n")
+        for r in rows:
+            f.write("| " + " | ".join([
+                r["_title"], fmt(r["before_tm_mean_ms"]), fmt(r["tm_mean_ms"]), fmt(r["ratio_tm_before_over_ours"], 2),
+                fmt(r["before_tr_mean_ms"]), fmt(r["tr_mean_ms"]), fmt(r["ratio_tr_before_over_ours"], 2),
+                fmt(r["before_iterations_mean"]), fmt(r["iterations_mean"]),
+                fmt(r["before_substeps_mean"], 3), fmt(r["substeps_mean"], 3)]) + " |\n")
 print(open(os.path.join(out, "paper_scenes.md")).read())
 EOF

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# The crane step by step, an earlier build against the current one, one after
+# the other on the same machine (docs/benchmarks.md section 4):
+#
+#   benchmarks/crane_timeline.sh --before PATH [--after PATH] [--duration T] [--out DIR]
+#
+# PATH: a crane_timeline program (benchmarks/crane_timeline.cpp); --after
+# defaults to build-bench/bin/crane_timeline (built when missing). Writes
+# DIR/crane_timeline.csv (rows labelled "before" and "after"),
+# DIR/crane_phases.md (each run's phase table) and DIR/crane_timeline.png
+# (gnuplot). DIR defaults to benchmarks/results. Each full run takes 5-12 min
+# on the 2-core development VM.
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+before=""
+after=""
+duration=""
+out="$root/benchmarks/results"
+usage() { sed -n '2,12p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --before) before=$2; shift 2 ;;
+    --after) after=$2; shift 2 ;;
+    --duration) duration=$2; shift 2 ;;
+    --out) out=$2; shift 2 ;;
+    -h|--help) usage; exit 0 ;;
+    *) echo "crane_timeline.sh: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
+  esac
+done
+[ -n "$before" ] || { echo "crane_timeline.sh: --before PATH is required" >&2; usage >&2; exit 2; }
+if [ -z "$after" ]; then
+  build="$root/build-bench"
+  if [ ! -f "$build/CMakeCache.txt" ]; then
+    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DODEMAG_CUDA=OFF -DODEMAG_BUILD_DEMOS=OFF >/dev/null
+  fi
+  cmake --build "$build" -j2 --target crane_timeline >/dev/null
+  after="$build/bin/crane_timeline"
+fi
+for p in "$before" "$after"; do
+  [ -x "$p" ] || { echo "crane_timeline.sh: $p is not an executable" >&2; exit 2; }
+done
+export OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+mkdir -p "$out"
+args=(--threads 2)
+[ -z "$duration" ] || args+=(--duration "$duration")
+"$before" "${args[@]}" --label before --csv "$work/before.csv" > "$work/before.md"
+"$after" "${args[@]}" --label after --csv "$work/after.csv" > "$work/after.md"
+{ cat "$work/before.csv"; tail -n +2 "$work/after.csv"; } > "$out/crane_timeline.csv"
+model=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')
+{
+  echo "Machine: $model, $(nproc) logical CPUs, 2 OpenMP threads (OMP_WAIT_POLICY=passive). Per rigid step (1 ms), means over each phase of the crane's time line; times in ms; dense evaluation: one responsive-field evaluation of the same cells (MagneticBackend::responsive_field) measured in the same run every 50 steps; T_m / evaluation: T_m in units of it."
+  echo
+  echo "Before ($before):"
+  echo
+  cat "$work/before.md"
+  echo
+  echo "After ($after):"
+  echo
+  cat "$work/after.md"
+} > "$out/crane_phases.md"
+if command -v gnuplot >/dev/null; then
+  (cd "$root" && gnuplot -e "R='$out/'" benchmarks/plot_crane_timeline.gp)
+fi
+cat "$out/crane_phases.md"
