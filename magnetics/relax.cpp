@@ -387,6 +387,13 @@ RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
   return report;
 }
 
+void magnetic_forces_at_held_magnetization(const MagneticModel& model, MagneticState& state,
+                                           const RelaxOptions& options, MagneticBackend& backend) {
+  place_cells_and_begin_step(model, state, options, backend);
+  compute_forces(model, state, backend);
+  state.last_solve.valid = false;  // the held magnetization is not the solution at these poses
+}
+
 void field_at_points(const MagneticModel& model, const MagneticState& state,
                      MagneticBackend& backend, const std::vector<Vec3>& points,
                      std::vector<Vec3>& B, std::vector<Vec3>& H) {

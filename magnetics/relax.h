@@ -76,6 +76,14 @@ RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxO
 RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
                           const RelaxOptions& options, MagneticBackend& backend);
 
+// Forces and torques at the current poses with the magnetization held: the
+// cells placed and the backend's step begun, then the forces (stages 1 and 4
+// of magnetic_step, no relaxation). Soft cells keep their moments in their
+// bodies' frames (place_cells turns them with the bodies), recoil magnets
+// their last applied field.
+void magnetic_forces_at_held_magnetization(const MagneticModel& model, MagneticState& state,
+                                           const RelaxOptions& options, MagneticBackend& backend);
+
 // B (T) and H (A/m) at world points after a relaxation. Inside a magnetic body
 // B = mu0 (H + M) with M of the body's nearest cell.
 void field_at_points(const MagneticModel& model, const MagneticState& state,

@@ -62,6 +62,11 @@ const RelaxReport& MagneticForces::compute() {
   return report_;
 }
 
+void MagneticForces::recompute_forces() {
+  read_poses();
+  magnetic_forces_at_held_magnetization(model_, state_, options_, *backend_);
+}
+
 const RelaxReport& MagneticForces::apply() {
   compute();
   add_forces();

@@ -57,6 +57,10 @@ class MagneticForces : public ForceAccumulator {
   void update(double, double) override { compute(); }
   void add_forces() override;
   const RelaxReport& compute();
+  // Forces and torques at the bodies' current poses with the magnetization of
+  // the last compute() held (magnetic_forces_at_held_magnetization): no
+  // relaxation. add_forces() then adds them.
+  void recompute_forces();
 
   void set_external_field(const Vec3& H) { state_.external_field = H; }
   Vec3 external_field() const { return state_.external_field; }

@@ -723,6 +723,8 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
      .doc = {"integer", "", "`64`"}},
     {.name = "stiffness_limit", .check = Check::positive, .slot = SLOT(stiffness_limit),
      .doc = {"number", "", "`1`"}},
+    {.name = "magnetic_solve", .check = Check::choice, .slot = SLOT(magnetic_solve),
+     .words = {"substep", "step"}, .doc = {"string", "", "`\"substep\"`"}},
 };
 
 const KeyTable<CameraSettings> kCameraKeys = {

@@ -87,6 +87,11 @@ struct SimulationSettings {
   // time (omega h <= stiffness_limit, omega^2 = |F| / (m size)). 1 disables.
   int max_substeps = 64;
   double stiffness_limit = 1.0;  // bound on omega h for the magnetic force (see above)
+  // When the magnetization is relaxed (docs/simulation.md "Substeps"):
+  // "substep", at every substep; "step", once per rigid step, the later
+  // substeps recomputing forces and torques at the new positions with the
+  // magnetization of the step's start.
+  std::string magnetic_solve = "substep";
 };
 
 // A keyframe of a scripted (kinematic) body.

@@ -24,6 +24,7 @@ struct StepRecord {
   // hold (docs/hard-cases.md: 1 mm objects at 4 ms steps).
   int substeps_wanted = 1;
   int iterations = 0;        // outer relaxation iterations, summed over the substeps
+  int relaxations = 0;       // substeps that relaxed the magnetization (SimulationSettings::magnetic_solve)
   int skipped = 0;           // substeps whose magnetic step was skipped (solver.skip_unchanged)
   bool converged = true;
   double residual = 0.0;

@@ -31,17 +31,9 @@ SceneDescription ball_onto_magnet(double dt) {
   return s;
 }
 
-class BallOntoMagnet : public ::testing::TestWithParam<double> {};
-
-TEST_P(BallOntoMagnet, ComesToRestTouchingItWithoutTunnellingOrNaN) {
-  const double dt = GetParam();
-  Simulation sim(ball_onto_magnet(dt));
-  double closest = 1.0;
-  while (sim.time() < 1.5) {
-    sim.step();
-    for (int b = 0; b < 2; ++b) ASSERT_TRUE(sim.finite_state(b)) << "t=" << sim.time();
-    closest = std::min(closest, norm(sim.world().pose(1).position - Vec3{0, 0, 0.008}));
-  }
+// The end of ball_onto_magnet: the ball at rest touching the magnet near its
+// pole; closest: the smallest centre distance seen during the run.
+void expect_resting_on_the_pole(const Simulation& sim, double closest, double dt) {
   const BodyPose ball = sim.world().pose(1);
   const Vec3 centre{0, 0, 0.008};
   // Touching: centres one sum of radii (13 mm) apart, within the 0.1 mm
@@ -57,7 +49,56 @@ TEST_P(BallOntoMagnet, ComesToRestTouchingItWithoutTunnellingOrNaN) {
   EXPECT_GT(closest, 0.013 - 0.3 * 0.005) << "dt=" << dt;
 }
 
+class BallOntoMagnet : public ::testing::TestWithParam<double> {};
+
+TEST_P(BallOntoMagnet, ComesToRestTouchingItWithoutTunnellingOrNaN) {
+  const double dt = GetParam();
+  Simulation sim(ball_onto_magnet(dt));
+  double closest = 1.0;
+  while (sim.time() < 1.5) {
+    sim.step();
+    for (int b = 0; b < 2; ++b) ASSERT_TRUE(sim.finite_state(b)) << "t=" << sim.time();
+    closest = std::min(closest, norm(sim.world().pose(1).position - Vec3{0, 0, 0.008}));
+  }
+  expect_resting_on_the_pole(sim, closest, dt);
+}
+
 INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnet, ::testing::Values(0.001, 0.004, 0.010));
+
+// simulation.magnetic_solve "step": one relaxation per rigid step, the later
+// substeps recomputing forces at the new positions with the magnetization
+// held. The same ball comes to rest the same way, and no step relaxes twice
+// although the approach takes several substeps.
+class BallOntoMagnetOneSolvePerStep : public ::testing::TestWithParam<double> {};
+
+TEST_P(BallOntoMagnetOneSolvePerStep, ComesToRestTouchingIt) {
+  const double dt = GetParam();
+  SceneDescription scene = ball_onto_magnet(dt);
+  scene.simulation.magnetic_solve = "step";
+  Simulation sim(scene);
+  double closest = 1.0;
+  int most_substeps = 0;
+  while (sim.time() < 1.5) {
+    sim.step();
+    for (int b = 0; b < 2; ++b) ASSERT_TRUE(sim.finite_state(b)) << "t=" << sim.time();
+    closest = std::min(closest, norm(sim.world().pose(1).position - Vec3{0, 0, 0.008}));
+    ASSERT_EQ(sim.records().back().relaxations, 1) << "t=" << sim.time();
+    most_substeps = std::max(most_substeps, sim.records().back().substeps);
+  }
+  EXPECT_GT(most_substeps, 1) << "dt=" << dt << ": the case never needed substeps";
+  expect_resting_on_the_pole(sim, closest, dt);
+}
+
+INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnetOneSolvePerStep, ::testing::Values(0.001, 0.004, 0.010));
+
+// With the default ("substep") every substep relaxes.
+TEST(BallOntoMagnet, EverySubstepRelaxesByDefault) {
+  Simulation sim(ball_onto_magnet(0.004));
+  while (sim.time() < 0.3) {
+    sim.step();
+    ASSERT_EQ(sim.records().back().relaxations, sim.records().back().substeps) << "t=" << sim.time();
+  }
+}
 
 // A magnet free to turn in a uniform field oscillates about it with the
 // small-angle period T = 2 pi sqrt(I / (mu0 m H)); the field pushes it nowhere.
