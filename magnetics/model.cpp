@@ -2,8 +2,11 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
+#include <string_view>
 
 #include "magnetics/kernels.h"
 
@@ -132,11 +135,33 @@ void build_boundary_correction(MagneticBody& body) {
 
 }  // namespace
 
+double body_lattice_points(const Shape& shape, double cell_size) {
+  if (!(cell_size > 0.0)) return 1.0;
+  const Vec3 half = shape_half_extents(shape);
+  double points = 1.0;
+  for (int a = 0; a < 3; ++a) points *= std::max(1.0, std::round(2.0 * half[a] / cell_size));
+  return points;
+}
+
+std::string validate_body_lattice(const std::string& name, const Shape& shape, double cell_size) {
+  const double points = body_lattice_points(shape, cell_size);
+  if (!(points > kMaxBodyLatticePoints)) return {};
+  char h[32];  // shortest round-trip form, as the scene loader writes numbers
+  const auto end = std::to_chars(h, h + sizeof h, cell_size).ptr;
+  std::ostringstream msg;
+  msg.precision(3);
+  msg << "cell size " << std::string_view(h, static_cast<size_t>(end - h)) << " gives body \"" << name << "\" a lattice of " << points
+      << " points; at most " << static_cast<long long>(kMaxBodyLatticePoints) << " are allowed";
+  return msg.str();
+}
+
 int MagneticModel::add_body(const std::string& name, const Shape& shape, const Material& material,
                             double cell_size) {
   if (std::string e = validate_shape(shape); !e.empty()) throw std::invalid_argument(e);
   if (std::string e = validate_material(material); !e.empty()) throw std::invalid_argument(e);
   if (!std::isfinite(cell_size)) throw std::invalid_argument("cell_size must be finite");
+  if (!is_inert(material))
+    if (std::string e = validate_body_lattice(name, shape, cell_size); !e.empty()) throw std::invalid_argument(e);
 
   MagneticBody body;
   body.name = name;

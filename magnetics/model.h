@@ -66,6 +66,22 @@ struct MagneticBody {
   }
 };
 
+// A body's lattice may have at most this many points: beyond it the per-body
+// tensors alone take gigabytes. MagneticModel::add_body and the scene loader
+// apply it (validate_body_lattice).
+inline constexpr double kMaxBodyLatticePoints = 4194304.0;  // 2^22
+
+// Points of the lattice a shape gets at cell_size: its bounding box over h^3,
+// per axis max(1, round(extent / h)); 1 for cell_size <= 0 (one cell). A
+// double, so that absurd lattices (1 m at 1 um: 1e18) count without overflow.
+double body_lattice_points(const Shape& shape, double cell_size);
+
+// Empty when a body of this shape at cell_size has at most
+// kMaxBodyLatticePoints lattice points; otherwise the message, naming the body
+// and giving the count and the limit. Shapes only: inert bodies, which get no
+// cells, are the caller's to skip.
+std::string validate_body_lattice(const std::string& name, const Shape& shape, double cell_size);
+
 class MagneticModel {
  public:
   MagneticModel() = default;
@@ -73,7 +89,9 @@ class MagneticModel {
   IntraBodyTensor intra_body_tensor() const { return intra_tensor_; }
 
   // Adds a body and returns its index. cell_size <= 0: one cell (spheres) or
-  // one cell at the centre. Throws std::invalid_argument on a bad shape or material.
+  // one cell at the centre. Throws std::invalid_argument on a bad shape or
+  // material, or a lattice beyond kMaxBodyLatticePoints (validate_body_lattice,
+  // checked before any cell is made).
   int add_body(const std::string& name, const Shape& shape, const Material& material,
                double cell_size);
 

@@ -1,9 +1,35 @@
 #include "engine/ode/magnetic_forces.h"
 
+#include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
 namespace odemag {
+
+namespace {
+
+bool finite(const Mat3& m) {
+  for (int i = 0; i < 3; ++i)
+    if (!is_finite(Vec3{m.m[i][0], m.m[i][1], m.m[i][2]})) return false;
+  return true;
+}
+
+std::string format(const Vec3& v) {
+  std::ostringstream s;
+  s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+  return s.str();
+}
+
+std::string format(const Mat3& m) {
+  std::ostringstream s;
+  s << "[";
+  for (int i = 0; i < 3; ++i) s << (i ? ", " : "") << format(Vec3{m.m[i][0], m.m[i][1], m.m[i][2]});
+  s << "]";
+  return s.str();
+}
+
+}  // namespace
 
 BodyPose ode_pose(dBodyID body) {
   BodyPose pose;
@@ -27,7 +53,10 @@ MagneticForces::MagneticForces(MagneticModel model, MagneticState state, const R
       state_(std::move(state)),
       bodies_(static_cast<size_t>(model_.body_count()), nullptr),
       backend_(backend ? std::move(backend) : make_cpu_backend()),
-      options_(options) {}
+      options_(options),
+      reference_force_(bodies_.size()),
+      reference_torque_(bodies_.size()),
+      reference_known_(bodies_.size(), 0) {}
 
 int MagneticForces::body_index(int index, const char* call) const {
   if (index < 0 || index >= model_.body_count())
@@ -38,6 +67,7 @@ int MagneticForces::body_index(int index, const char* call) const {
 
 void MagneticForces::bind(int index, dBodyID body) {
   bodies_[body_index(index, "bind")] = body;
+  reference_known_[index] = 0;
   if (body) state_.pose[index] = ode_pose(body);
 }
 
@@ -47,8 +77,45 @@ int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& mat
                                     shape, material, cell_size);
   extend_state(model_, state_);
   bodies_.push_back(body);
+  reference_force_.emplace_back();
+  reference_torque_.emplace_back();
+  reference_known_.push_back(0);
   if (body) state_.pose[index] = ode_pose(body);
   return index;
+}
+
+void MagneticForces::set_external_field(const Vec3& H) {
+  if (!is_finite(H))
+    throw std::invalid_argument("MagneticForces::set_external_field: the field " + format(H) + " is not finite");
+  state_.external_field = H;
+}
+
+void MagneticForces::set_wake_tolerance(double tolerance) {
+  if (!(tolerance >= 0.0))
+    throw std::invalid_argument("MagneticForces::set_wake_tolerance: the tolerance must be >= 0");
+  wake_tolerance_ = tolerance;
+}
+
+void MagneticForces::set_magnetization_scale(int index, double scale) {
+  const int b = body_index(index, "set_magnetization_scale");
+  if (!std::isfinite(scale))
+    throw std::invalid_argument("MagneticForces::set_magnetization_scale: the scale of body " +
+                                std::to_string(b) + " \"" + model_.body(b).name + "\" is not finite");
+  state_.magnetization_scale[b] = scale;
+}
+
+void MagneticForces::set_pose(int index, const BodyPose& pose) {
+  const int b = body_index(index, "set_pose");
+  if (!is_finite(pose.position) || !finite(pose.rotation))
+    throw std::invalid_argument("MagneticForces::set_pose: the pose of body " + std::to_string(b) + " \"" +
+                                model_.body(b).name + "\" is not finite (position " + format(pose.position) +
+                                ", rotation " + format(pose.rotation) + ")");
+  state_.pose[b] = pose;
+}
+
+Vec3 MagneticForces::moment(int index) const {
+  const int b = body_index(index, "moment");
+  return state_.active[b] ? body_moment(model_, state_, b) : Vec3{};
 }
 
 void MagneticForces::read_poses() {
@@ -56,14 +123,34 @@ void MagneticForces::read_poses() {
     if (bodies_[b]) state_.pose[b] = ode_pose(bodies_[b]);
 }
 
+void MagneticForces::check_inputs(const char* call) const {
+  const std::string where = std::string("MagneticForces::") + call + ": ";
+  if (!is_finite(state_.external_field))
+    throw std::domain_error(where + "the external field " + format(state_.external_field) + " is not finite");
+  for (int b = 0; b < model_.body_count(); ++b) {
+    if (!state_.active[b]) continue;  // neither makes nor feels a field
+    const BodyPose& pose = state_.pose[b];
+    const char* what = !is_finite(pose.position) ? "position" : !finite(pose.rotation) ? "rotation" : nullptr;
+    if (what)
+      throw std::domain_error(where + "body " + std::to_string(b) + " \"" + model_.body(b).name + "\" has a " +
+                              (bodies_[b] ? "non-finite ODE " : "non-finite ") + what + " (position " +
+                              format(pose.position) + ", rotation " + format(pose.rotation) + ")");
+    if (!std::isfinite(state_.magnetization_scale[b]))
+      throw std::domain_error(where + "body " + std::to_string(b) + " \"" + model_.body(b).name +
+                              "\" has a non-finite magnetization scale");
+  }
+}
+
 const RelaxReport& MagneticForces::compute() {
   read_poses();
+  check_inputs("compute");
   report_ = magnetic_step(model_, state_, options_, *backend_);
   return report_;
 }
 
 void MagneticForces::recompute_forces() {
   read_poses();
+  check_inputs("recompute_forces");
   magnetic_forces_at_held_magnetization(model_, state_, options_, *backend_);
 }
 
@@ -73,12 +160,36 @@ const RelaxReport& MagneticForces::apply() {
   return report_;
 }
 
+bool MagneticForces::wakes(int b) const {
+  dBodyID body = bodies_[b];
+  if (!dBodyGetAutoDisableFlag(body)) return false;  // disabled by the program, not asleep
+  dMass mass;
+  dBodyGetMass(body, &mass);
+  dVector3 g;
+  dWorldGetGravity(dBodyGetWorld(body), g);
+  const Vec3 f0 = reference_force_[b], t0 = reference_torque_[b];
+  const double load = norm(f0) + mass.mass * norm(Vec3{g[0], g[1], g[2]});
+  const double r = norm(shape_half_extents(model_.body(b).shape));
+  return norm(state_.force[b] - f0) > wake_tolerance_ * load ||
+         norm(state_.torque[b] - t0) > wake_tolerance_ * (norm(t0) + r * load);
+}
+
+void MagneticForces::note_reference(int b) {
+  reference_force_[b] = state_.force[b];
+  reference_torque_[b] = state_.torque[b];
+  reference_known_[b] = 1;
+}
+
 void MagneticForces::add_forces() {
   for (int b = 0; b < model_.body_count(); ++b) {
     dBodyID body = bodies_[b];
-    if (!body || !state_.active[b] || model_.body(b).inert() || dBodyIsKinematic(body) ||
-        !dBodyIsEnabled(body))
-      continue;
+    if (!body || !state_.active[b] || model_.body(b).inert() || dBodyIsKinematic(body)) continue;
+    if (!dBodyIsEnabled(body)) {
+      if (!reference_known_[b]) note_reference(b);  // never seen awake: its forces now are the reference
+      if (!wakes(b)) continue;
+      dBodyEnable(body);
+    }
+    note_reference(b);
     const Vec3& f = state_.force[b];
     const Vec3& t = state_.torque[b];
     dBodyAddForce(body, f.x, f.y, f.z);

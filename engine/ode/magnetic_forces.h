@@ -14,6 +14,7 @@
 
 #include <ode/ode.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -44,17 +45,35 @@ class MagneticForces : public ForceAccumulator {
   // Attaches a shape (centred on the body's centre of mass, in its frame) and
   // a material to an ODE body and returns the magnetic body index. body may be
   // nullptr for a static body placed with set_pose. cell_size <= 0: one cell.
-  // Throws std::invalid_argument on a bad shape or material.
+  // Throws std::invalid_argument on a bad shape or material, or a lattice of
+  // more than kMaxBodyLatticePoints points (magnetics/model.h), before any
+  // cell is made.
   int attach(dBodyID body, const Shape& shape, const Material& material, double cell_size = 0.0,
              const std::string& name = "");
 
   // Reads the poses of the ODE bodies, relaxes the magnetization from the
   // previous step's moments, computes forces and torques and adds them to the
-  // (non-kinematic, enabled) ODE bodies. Returns the relaxation report.
+  // (non-kinematic, enabled or woken) ODE bodies. Returns the relaxation report.
   const RelaxReport& apply();
 
   // ForceAccumulator: update() relaxes and computes, add_forces() adds.
+  // compute() and recompute_forces() throw std::domain_error, naming the
+  // body (name and index), when an active body's pose (its ODE body's, or
+  // the one set_pose or state() gave it), its magnetization scale or the
+  // external field is not finite; they check before relaxing, the state
+  // keeps the last step's forces.
   void update(double, double) override { compute(); }
+  // Adds the forces and torques to the active, magnetic, non-kinematic ODE
+  // bodies that are enabled. A body ODE put to sleep (disabled, its
+  // auto-disable flag set) is woken (dBodyEnable) when its magnetic force
+  // or torque has changed, since the last add_forces() that found it awake
+  // (or the first that found it asleep, for a body never seen awake), by
+  // more than wake_tolerance() times the load that holds it at rest:
+  //   |F - F_0| > tol (|F_0| + m |g|)  or  |T - T_0| > tol (|T_0| + r (|F_0| + m |g|)),
+  // m its ODE mass, g the world's gravity, r half the diagonal of the
+  // shape's bounding box. A body resting in a steady field stays asleep; one a magnet
+  // approaches is woken. Bodies whose auto-disable flag is off (disabled by
+  // the program, as the scene simulation removes bodies) are never woken.
   void add_forces() override;
   const RelaxReport& compute();
   // Forces and torques at the bodies' current poses with the magnetization of
@@ -62,22 +81,28 @@ class MagneticForces : public ForceAccumulator {
   // relaxation. add_forces() then adds them.
   void recompute_forces();
 
-  void set_external_field(const Vec3& H) { state_.external_field = H; }
+  // Throws std::invalid_argument when H is not finite.
+  void set_external_field(const Vec3& H);
   Vec3 external_field() const { return state_.external_field; }
-  // Every call taking a body index throws std::out_of_range when it is not
-  // 0 .. body_count() - 1.
+  // Relative change of force or torque that wakes a sleeping body
+  // (add_forces); default 1e-3, infinity never wakes. Throws
+  // std::invalid_argument when negative or NaN.
+  void set_wake_tolerance(double tolerance);
+  double wake_tolerance() const { return wake_tolerance_; }
+  // Every call taking a body index throws std::out_of_range naming the call
+  // and the index when it is not 0 .. body_count() - 1.
   // A body that is not active neither makes nor feels a field (removed).
   void set_active(int index, bool active) { state_.active[body_index(index, "set_active")] = active ? 1 : 0; }
   bool active(int index) const { return state_.active[body_index(index, "active")] != 0; }
-  // Scales a permanent magnet's remanent magnetization (electromagnets, the crane).
-  void set_magnetization_scale(int index, double scale) {
-    state_.magnetization_scale[body_index(index, "set_magnetization_scale")] = scale;
-  }
+  // Scales a permanent magnet's remanent magnetization (electromagnets, the
+  // crane). Throws std::invalid_argument when scale is not finite.
+  void set_magnetization_scale(int index, double scale);
   double magnetization_scale(int index) const {
     return state_.magnetization_scale[body_index(index, "magnetization_scale")];
   }
-  // Pose of a static (body == nullptr) magnetic body.
-  void set_pose(int index, const BodyPose& pose) { state_.pose[body_index(index, "set_pose")] = pose; }
+  // Pose of a static (body == nullptr) magnetic body. Throws
+  // std::invalid_argument when it is not finite.
+  void set_pose(int index, const BodyPose& pose);
 
   RelaxOptions& options() { return options_; }
   const RelaxOptions& options() const { return options_; }
@@ -86,7 +111,7 @@ class MagneticForces : public ForceAccumulator {
   int body_count() const { return model_.body_count(); }
   dBodyID ode_body(int index) const { return bodies_[body_index(index, "ode_body")]; }
   // A m^2, world; zero for a body that is not active.
-  Vec3 moment(int index) const { return active(index) ? body_moment(model_, state_, index) : Vec3{}; }
+  Vec3 moment(int index) const;
   Vec3 force(int index) const { return state_.force[body_index(index, "force")]; }                  // N, world
   Vec3 torque(int index) const { return state_.torque[body_index(index, "torque")]; }                // N m, about the CoM
 
@@ -99,6 +124,12 @@ class MagneticForces : public ForceAccumulator {
   // index, or std::out_of_range naming the call when it is not a body index.
   int body_index(int index, const char* call) const;
   void read_poses();
+  // std::domain_error, naming call and body, on a non-finite input of a step.
+  void check_inputs(const char* call) const;
+  // add_forces: whether sleeping body b is to be woken.
+  bool wakes(int b) const;
+  // add_forces: the body's force and torque become its F_0, T_0.
+  void note_reference(int b);
 
   MagneticModel model_;
   MagneticState state_;
@@ -106,6 +137,10 @@ class MagneticForces : public ForceAccumulator {
   std::unique_ptr<MagneticBackend> backend_;
   RelaxOptions options_;
   RelaxReport report_;
+  double wake_tolerance_ = 1e-3;
+  // Per body: F_0, T_0 of the wake-up rule (add_forces), and whether set.
+  std::vector<Vec3> reference_force_, reference_torque_;
+  std::vector<uint8_t> reference_known_;
 };
 
 // Pose of an ODE body as a magnetics BodyPose.

@@ -1,12 +1,20 @@
 // The embedding API (engine/ode/magnetic_forces.h): bad body indices throw,
 // and magnetics built from a scene and bound to ODE bodies (the simulation's
 // path) give the same forces as the same bodies attached one by one (an
-// embedder's path).
+// embedder's path). Input checks (lattice limit, finite poses and fields) and
+// the wake-up of bodies ODE put to sleep.
 #include <gtest/gtest.h>
 
 #include <ode/ode.h>
 
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "engine/ode/magnetic_forces.h"
 #include "engine/scene/scene.h"
@@ -99,6 +107,319 @@ TEST(MagneticForcesApi, SceneBuiltAndBoundEqualsAttachedOneByOne) {
     EXPECT_EQ(bound.torque(i).z, attached.torque(i).z) << i;
   }
   EXPECT_GT(norm(bound.force(1)), 0.0);
+}
+
+// Every index-taking call, with and without bodies attached, throws
+// std::out_of_range naming itself and the index (moment() named active()).
+TEST(MagneticForcesApi, EveryIndexCallThrowsNamingItselfAndTheIndex) {
+  for (int attached : {0, 2}) {
+    MagneticForces magnetics;
+    for (int b = 0; b < attached; ++b) magnetics.attach(nullptr, Sphere{0.005}, PermanentMaterial{{0, 0, 1e6}, 0.0});
+    std::vector<std::pair<std::string, std::function<void(int)>>> calls = {
+        {"force", [&](int i) { (void)magnetics.force(i); }},
+        {"torque", [&](int i) { (void)magnetics.torque(i); }},
+        {"moment", [&](int i) { (void)magnetics.moment(i); }},
+        {"set_pose", [&](int i) { magnetics.set_pose(i, BodyPose{}); }},
+        {"bind", [&](int i) { magnetics.bind(i, nullptr); }},
+        {"set_active", [&](int i) { magnetics.set_active(i, true); }},
+        {"active", [&](int i) { (void)magnetics.active(i); }},
+        {"set_magnetization_scale", [&](int i) { magnetics.set_magnetization_scale(i, 1.0); }},
+        {"magnetization_scale", [&](int i) { (void)magnetics.magnetization_scale(i); }},
+        {"ode_body", [&](int i) { (void)magnetics.ode_body(i); }},
+    };
+    for (const auto& [name, call] : calls)
+      for (int bad : {-1, attached, 7, 1000}) {
+        try {
+          call(bad);
+          ADD_FAILURE() << name << "(" << bad << ") with " << attached << " bodies: no exception";
+        } catch (const std::out_of_range& e) {
+          const std::string what = e.what();
+          EXPECT_NE(what.find("MagneticForces::" + name + ":"), std::string::npos) << what;
+          EXPECT_NE(what.find("body " + std::to_string(bad) + " "), std::string::npos) << what;
+        }
+      }
+    for (int b = 0; b < attached; ++b)
+      for (const auto& [name, call] : calls) EXPECT_NO_THROW(call(b)) << name << "(" << b << ")";
+  }
+}
+
+// A lattice beyond kMaxBodyLatticePoints is refused before a cell is made:
+// a 1 m box at 1 um (1e18 points) used to hang.
+TEST(MagneticForcesApi, LatticeBeyondTheLimitThrowsAtOnce) {
+  MagneticForces magnetics;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    magnetics.attach(nullptr, Box{{1.0, 1.0, 1.0}}, PermanentMaterial{{1e6, 0, 0}, 0.0}, 1e-6, "slab");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cell size 1e-06 gives body \"slab\""), std::string::npos) << what;
+    EXPECT_NE(what.find("1e+18"), std::string::npos) << what;
+    EXPECT_NE(what.find("4194304"), std::string::npos) << what;
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
+  EXPECT_EQ(magnetics.body_count(), 0);
+  // Soft and cylindrical bodies too; an inert body gets no cells and passes.
+  SoftMaterial iron;
+  iron.saturation = 1.7e6;
+  auto lattice_error = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what()).find("lattice") != std::string::npos;
+    }
+    return false;
+  };
+  EXPECT_TRUE(lattice_error([&] { magnetics.attach(nullptr, Cylinder{0.5, 1.0}, iron, 1e-5); }));
+  EXPECT_NO_THROW(magnetics.attach(nullptr, Box{{1.0, 1.0, 1.0}}, InertMaterial{}, 1e-6));
+  MagneticModel model;
+  EXPECT_TRUE(lattice_error([&] { model.add_body("slab", Box{{1.0, 1.0, 1.0}}, iron, 1e-6); }));
+  EXPECT_EQ(model.body_count(), 0);
+}
+
+// The count is the scene loader's: per axis max(1, round(extent / h)).
+TEST(MagneticForcesApi, LatticeCountAndLimit) {
+  EXPECT_EQ(body_lattice_points(Box{{0.01, 0.02, 0.03}}, 0.01), 6.0);
+  EXPECT_EQ(body_lattice_points(Box{{0.01, 0.02, 0.03}}, 0.0), 1.0);
+  EXPECT_EQ(body_lattice_points(Sphere{0.01}, 0.003), 7.0 * 7.0 * 7.0);  // round(6.67)
+  EXPECT_EQ(body_lattice_points(Box{{0.001, 0.1, 0.1}}, 0.01), 100.0);    // at least 1 per axis
+  EXPECT_EQ(validate_body_lattice("b", Box{{1.28, 1.28, 2.56}}, 0.01), "");  // 2^22 exactly
+  const std::string e = validate_body_lattice("b", Box{{1.28, 1.28, 2.57}}, 0.01);
+  EXPECT_NE(e.find("\"b\""), std::string::npos) << e;
+  EXPECT_NE(e.find("4.21e+06"), std::string::npos) << e;
+  EXPECT_NE(e.find("at most 4194304"), std::string::npos) << e;
+}
+
+// A magnet in a box and an iron ball on an ODE body, for the pose checks.
+struct MagnetAndBall {
+  MagnetAndBall() : ball_body(ode.body_at({0.03, 0, 0})) {
+    SoftMaterial iron;
+    iron.saturation = 1.7e6;
+    iron.susceptibility = 5000;
+    magnet = magnetics.attach(nullptr, Box{{0.02, 0.01, 0.01}}, PermanentMaterial{{8e5, 0, 0}, 0.0}, 0.005, "bar");
+    ball = magnetics.attach(ball_body, Sphere{0.005}, iron, 0.0, "ball");
+  }
+  OdeWorld ode;
+  dBodyID ball_body;
+  MagneticForces magnetics{{}, make_cpu_backend(1)};
+  int magnet = -1, ball = -1;
+};
+
+void expect_names(const std::string& what, const std::string& call, const std::string& body, int index) {
+  EXPECT_NE(what.find(call), std::string::npos) << what;
+  EXPECT_NE(what.find("body " + std::to_string(index) + " \"" + body + "\""), std::string::npos) << what;
+}
+
+TEST(MagneticForcesApi, NonFinitePoseThrowsNamingTheBody) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  MagnetAndBall s;
+  s.magnetics.compute();
+  const Vec3 force = s.magnetics.force(s.ball);
+  ASSERT_GT(norm(force), 0.0);
+
+  // set_pose refuses at once and keeps the pose it had.
+  BodyPose pose;
+  pose.position = {nan, 0, 0};
+  try {
+    s.magnetics.set_pose(s.magnet, pose);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    expect_names(e.what(), "set_pose", "bar", s.magnet);
+  }
+  pose.position = {};
+  pose.rotation.m[1][2] = inf;
+  EXPECT_THROW(s.magnetics.set_pose(s.magnet, pose), std::invalid_argument);
+  EXPECT_TRUE(std::isfinite(s.magnetics.state().pose[s.magnet].position.x));
+  EXPECT_EQ(s.magnetics.state().pose[s.magnet].rotation.m[1][2], 0.0);
+
+  // An ODE body's position: compute, apply and recompute_forces throw before
+  // relaxing; the forces stay the last step's.
+  dBodySetPosition(s.ball_body, 0.03, nan, 0);
+  for (const char* call : {"compute", "apply", "recompute_forces"}) {
+    try {
+      if (std::string(call) == "compute") s.magnetics.compute();
+      if (std::string(call) == "apply") s.magnetics.apply();
+      if (std::string(call) == "recompute_forces") s.magnetics.recompute_forces();
+      ADD_FAILURE() << call << ": no exception";
+    } catch (const std::domain_error& e) {
+      expect_names(e.what(), std::string("MagneticForces::") + (std::string(call) == "apply" ? "compute" : call),
+                   "ball", s.ball);
+      EXPECT_NE(std::string(e.what()).find("position"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(s.magnetics.force(s.ball).x, force.x);
+  const dReal* f = dBodyGetForce(s.ball_body);
+  EXPECT_EQ(f[0], 0.0);  // apply() added nothing
+
+  // An inactive body's pose is not used: no error.
+  s.magnetics.set_active(s.ball, false);
+  EXPECT_NO_THROW(s.magnetics.compute());
+  s.magnetics.set_active(s.ball, true);
+  dBodySetPosition(s.ball_body, 0.03, 0, 0);
+  EXPECT_NO_THROW(s.magnetics.compute());
+
+  // A static pose made non-finite through state(): rotation.
+  s.magnetics.state().pose[s.magnet].rotation.m[0][0] = nan;
+  try {
+    s.magnetics.compute();
+    FAIL() << "no exception";
+  } catch (const std::domain_error& e) {
+    expect_names(e.what(), "MagneticForces::compute", "bar", s.magnet);
+    EXPECT_NE(std::string(e.what()).find("rotation"), std::string::npos) << e.what();
+  }
+  s.magnetics.state().pose[s.magnet].rotation = Mat3{};
+  EXPECT_NO_THROW(s.magnetics.compute());
+}
+
+TEST(MagneticForcesApi, NonFiniteFieldAndScaleThrow) {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  MagnetAndBall s;
+  EXPECT_THROW(s.magnetics.set_external_field({0, inf, 0}), std::invalid_argument);
+  EXPECT_THROW(s.magnetics.set_external_field({nan, 0, 0}), std::invalid_argument);
+  EXPECT_EQ(s.magnetics.external_field().y, 0.0);
+  EXPECT_NO_THROW(s.magnetics.set_external_field({0, 100, 0}));
+  EXPECT_THROW(s.magnetics.set_magnetization_scale(s.magnet, nan), std::invalid_argument);
+  EXPECT_EQ(s.magnetics.magnetization_scale(s.magnet), 1.0);
+  s.magnetics.state().external_field = {0, 0, -inf};
+  try {
+    s.magnetics.compute();
+    FAIL() << "no exception";
+  } catch (const std::domain_error& e) {
+    EXPECT_NE(std::string(e.what()).find("external field"), std::string::npos) << e.what();
+  }
+}
+
+// An ODE world with auto-disable on: a ground plane and an iron ball resting
+// on it, stepped with contacts.
+struct SleepyWorld {
+  static constexpr double kRadius = 0.005, kStep = 1e-3;
+  SleepyWorld() {
+    dInitODE();
+    world = dWorldCreate();
+    space = dSimpleSpaceCreate(nullptr);
+    contacts = dJointGroupCreate(0);
+    dWorldSetGravity(world, 0, 0, -9.81);
+    dWorldSetContactSurfaceLayer(world, 1e-4);
+    dWorldSetAutoDisableFlag(world, 1);  // bodies created from now on may sleep
+    dCreatePlane(space, 0, 0, 1, 0);
+    ball = dBodyCreate(world);
+    dMass m;
+    dMassSetSphere(&m, 7800.0, kRadius);
+    dBodySetMass(ball, &m);
+    dBodySetPosition(ball, 0, 0, kRadius);
+    dGeomSetBody(dCreateSphere(space, kRadius), ball);
+    SoftMaterial iron;
+    iron.saturation = 1.7e6;
+    iron.susceptibility = 5000;
+    magnetics.attach(ball, Sphere{kRadius}, iron, 0.0, "ball");
+  }
+  ~SleepyWorld() {
+    dJointGroupDestroy(contacts);
+    dSpaceDestroy(space);
+    dWorldDestroy(world);
+    dCloseODE();
+  }
+  static void near(void* data, dGeomID a, dGeomID b) {
+    auto* w = static_cast<SleepyWorld*>(data);
+    dContact c[4];
+    const int n = dCollide(a, b, 4, &c[0].geom, sizeof(dContact));
+    for (int i = 0; i < n; ++i) {
+      c[i].surface.mode = 0;
+      c[i].surface.mu = 0.5;
+      dJointAttach(dJointCreateContact(w->world, w->contacts, &c[i]), dGeomGetBody(a), dGeomGetBody(b));
+    }
+  }
+  void step() {
+    magnetics.apply();
+    dSpaceCollide(space, this, &near);
+    dWorldQuickStep(world, kStep);
+    dJointGroupEmpty(contacts);
+  }
+  // Steps until the ball is asleep (at most n steps); whether it is.
+  bool sleep(int n) {
+    for (int i = 0; i < n && dBodyIsEnabled(ball); ++i) step();
+    return !dBodyIsEnabled(ball);
+  }
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  dBodyID ball;
+  MagneticForces magnetics{{}, make_cpu_backend(1)};
+};
+
+BodyPose at(const Vec3& p) {
+  BodyPose pose;
+  pose.position = p;
+  return pose;
+}
+
+// A magnet (static, with a body-less geom) moved toward a sleeping ball wakes
+// it, and the ball rolls to it.
+TEST(MagneticForcesWake, ApproachingMagnetWakesASleepingBall) {
+  SleepyWorld w;
+  const int magnet =
+      w.magnetics.attach(nullptr, Box{{0.02, 0.02, 0.02}}, PermanentMaterial{{1e6, 0, 0}, 0.0}, 0.01, "magnet");
+  dGeomID geom = dCreateBox(w.space, 0.02, 0.02, 0.02);
+  auto place = [&](double x) {
+    w.magnetics.set_pose(magnet, at({x, 0, 0.01}));
+    dGeomSetPosition(geom, x, 0, 0.01);
+  };
+  place(0.3);
+  ASSERT_TRUE(w.sleep(2000));
+  for (int i = 0; i < 100; ++i) w.step();
+  ASSERT_FALSE(dBodyIsEnabled(w.ball)) << "a far magnet that does not move leaves it asleep";
+  int woke = -1;
+  for (int i = 0; i < 3000; ++i) {
+    place(std::max(0.08, 0.3 - 0.5 * SleepyWorld::kStep * i));  // 0.5 m/s, then held 8 cm away
+    w.step();
+    if (woke < 0 && dBodyIsEnabled(w.ball)) woke = i;
+  }
+  EXPECT_GE(woke, 0);
+  EXPECT_LT(woke, 440) << "woken while the magnet approached";
+  // Rolled to the magnet and touching it: x = 0.08 - 0.01 - R.
+  EXPECT_NEAR(dBodyGetPosition(w.ball)[0], 0.08 - 0.01 - SleepyWorld::kRadius, 1e-3);
+}
+
+// A ball held to the ground by a magnet under it (a steady force, over 100
+// times its weight) falls asleep and stays asleep.
+TEST(MagneticForcesWake, BallInASteadyFieldStaysAsleep) {
+  SleepyWorld w;
+  const int magnet =
+      w.magnetics.attach(nullptr, Box{{0.02, 0.02, 0.02}}, PermanentMaterial{{0, 0, 1e6}, 0.0}, 0.01, "magnet");
+  w.magnetics.set_pose(magnet, at({0, 0, -0.012}));
+  w.magnetics.set_external_field({0, 0, 1000});
+  ASSERT_TRUE(w.sleep(3000));
+  dMass m;
+  dBodyGetMass(w.ball, &m);
+  EXPECT_GT(norm(w.magnetics.force(0)), 5.0 * m.mass * 9.81);
+  const Vec3 p0{dBodyGetPosition(w.ball)[0], dBodyGetPosition(w.ball)[1], dBodyGetPosition(w.ball)[2]};
+  for (int i = 0; i < 500; ++i) {
+    w.step();
+    ASSERT_FALSE(dBodyIsEnabled(w.ball)) << "woken at step " << i;
+  }
+  EXPECT_EQ(dBodyGetPosition(w.ball)[2], p0.z);
+  // A change of the field well above the tolerance wakes it.
+  w.magnetics.set_magnetization_scale(magnet, 0.5);
+  w.step();
+  EXPECT_TRUE(dBodyIsEnabled(w.ball));
+}
+
+// Bodies whose auto-disable flag is off were disabled by the program (the
+// scene simulation's removed bodies): never woken.
+TEST(MagneticForcesWake, DisabledByTheProgramStaysDisabled) {
+  SleepyWorld w;
+  dBodySetAutoDisableFlag(w.ball, 0);
+  const int magnet =
+      w.magnetics.attach(nullptr, Box{{0.02, 0.02, 0.02}}, PermanentMaterial{{1e6, 0, 0}, 0.0}, 0.01, "magnet");
+  w.magnetics.set_pose(magnet, at({0.3, 0, 0.01}));
+  w.step();
+  dBodyDisable(w.ball);
+  for (int i = 0; i < 200; ++i) {
+    w.magnetics.set_pose(magnet, at({0.3 - 0.001 * i, 0, 0.01}));
+    w.step();
+  }
+  EXPECT_FALSE(dBodyIsEnabled(w.ball));
+  EXPECT_THROW(w.magnetics.set_wake_tolerance(-1.0), std::invalid_argument);
 }
 
 }  // namespace

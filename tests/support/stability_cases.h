@@ -362,7 +362,8 @@ inline CaseResult run_case(const std::string& name, const SceneDescription& scen
     if (!r.non_finite.empty()) r.finite = false;
     if (!r.finite) break;
   }
-  sim.magnetics().compute();  // the end state, relaxed at the final poses
+  // The end state, relaxed at the final poses (a non-finite pose throws).
+  if (r.finite) sim.magnetics().compute();
   sampler.sample();
   r.steps = sim.steps();
   for (int b = 0; b < sim.world().body_count(); ++b) {
