@@ -92,6 +92,7 @@ RelaxReport relax_paper(const MagneticModel& model, MagneticState& state, const 
     report.llg_steps += s.llg_steps;
     report.residual = s.max_residual;
     report.residual_history.push_back(s.max_residual);
+    if (o.progress) o.progress(report);
     if (s.llg_steps == 0) {
       report.converged = true;
       break;
@@ -292,6 +293,7 @@ RelaxReport relax_two_level(const MagneticModel& model, MagneticState& state, co
     const double worst = iterate_residual(l, G, f);
     report.residual = worst;
     report.residual_history.push_back(worst);
+    if (o.progress) o.progress(report);
     if (worst <= o.tolerance) {
       report.converged = true;
       for (size_t i = 0; i < cells.size(); ++i) l.H_A[cells[i]] = G[i];

@@ -3,6 +3,7 @@
 // rest of a magnetic step.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "magnetics/backend.h"
@@ -21,6 +22,8 @@ enum class RelaxScheme {
   // every moment by one LLG step.
   paper,
 };
+
+struct RelaxReport;
 
 struct RelaxOptions {
   RelaxScheme scheme = RelaxScheme::two_level;
@@ -52,6 +55,9 @@ struct RelaxOptions {
   // coupling of aligned lattice cells. false: point dipoles only (the paper).
   bool near_field = true;
   LocalRelaxOptions local;
+  // Called after every outer iteration with the report so far (iterations,
+  // residual_history): progress lines of a long `odemag solve`. Empty: none.
+  std::function<void(const RelaxReport&)> progress;
 };
 
 struct RelaxReport {

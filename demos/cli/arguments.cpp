@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include "demos/cli/cli.h"
@@ -49,22 +50,24 @@ Arguments parse_arguments(const std::string& command, const std::vector<std::str
   return out;
 }
 
-SolveOptions solve_options(const Arguments& args) {
-  SolveOptions o;
-  if (auto b = args.option("backend")) {
-    if (*b != "cpu" && *b != "cuda" && *b != "auto")
-      throw UsageError("--backend must be cpu, cuda or auto, not '" + *b + "'");
-    o.backend = *b;
+int program_main(const std::string& program, const char* usage, const std::vector<std::string>& args,
+                 const std::vector<std::string>& known, const std::function<int(const Arguments&)>& body) {
+  for (const std::string& a : args) {
+    if (a == "--") break;
+    if (a == "--help" || a == "-h") {
+      write_stdout(usage);
+      return 0;
+    }
   }
-  if (auto t = args.option("threads")) {
-    errno = 0;
-    char* end = nullptr;
-    const long n = std::strtol(t->c_str(), &end, 10);
-    if (t->empty() || *end != '\0' || errno != 0 || n < 0 || n > 65536)
-      throw UsageError("--threads must be an integer from 0 (all cores) to 65536, not '" + *t + "'");
-    o.threads = static_cast<int>(n);
+  try {
+    return body(parse_arguments(program, args, known));
+  } catch (const UsageError& e) {
+    std::string message = e.what();  // the parser points at odemag's help
+    if (const size_t at = message.find("odemag --help"); at != std::string::npos)
+      message.replace(at, 13, program + " --help");
+    std::fprintf(stderr, "%s: %s\n", program.c_str(), one_line(message).c_str());
+    return 2;
   }
-  return o;
 }
 
 namespace {
@@ -100,8 +103,27 @@ bool yes_no_option(const Arguments& a, const std::string& name, bool fallback) {
 
 }  // namespace
 
+SolveOptions solve_options(const Arguments& args) {
+  SolveOptions o;
+  o.max_cell_pairs = number_option(args, "max-cell-pairs", false).value_or(kDefaultMaxCellPairs);
+  if (auto b = args.option("backend")) {
+    if (*b != "cpu" && *b != "cuda" && *b != "auto")
+      throw UsageError("--backend must be cpu, cuda or auto, not '" + *b + "'");
+    o.backend = *b;
+  }
+  if (auto t = args.option("threads")) {
+    errno = 0;
+    char* end = nullptr;
+    const long n = std::strtol(t->c_str(), &end, 10);
+    if (t->empty() || *end != '\0' || errno != 0 || n < 0 || n > 65536)
+      throw UsageError("--threads must be an integer from 0 (all cores) to 65536, not '" + *t + "'");
+    o.threads = static_cast<int>(n);
+  }
+  return o;
+}
+
 SolveCommandLine parse_solve_command(const std::vector<std::string>& args) {
-  const Arguments a = parse_arguments("solve", args, {"backend", "threads"});
+  const Arguments a = parse_arguments("solve", args, {"backend", "threads", "max-cell-pairs"});
   SolveCommandLine c;
   c.solve = solve_options(a);
   c.scene = scene_argument("solve", a);
@@ -109,7 +131,7 @@ SolveCommandLine parse_solve_command(const std::vector<std::string>& args) {
 }
 
 FieldCommandLine parse_field_command(const std::vector<std::string>& args) {
-  const Arguments a = parse_arguments("field", args, {"points", "backend", "threads"});
+  const Arguments a = parse_arguments("field", args, {"points", "backend", "threads", "max-cell-pairs"});
   FieldCommandLine c;
   c.solve = solve_options(a);
   c.scene = scene_argument("field", a);
@@ -122,7 +144,8 @@ FieldCommandLine parse_field_command(const std::vector<std::string>& args) {
 RunCommandLine parse_run_command(const std::vector<std::string>& args) {
   const Arguments a = parse_arguments(
       "run", args,
-      {"out", "duration", "frame-rate", "time-step", "frames", "width", "height", "backend", "threads", "quiet"});
+      {"out", "duration", "frame-rate", "time-step", "frames", "width", "height", "backend", "threads", "quiet",
+       "max-cell-pairs", "max-steps"});
   RunCommandLine c;
   c.scene = scene_argument("run", a);
   const auto out = a.option("out");
@@ -134,6 +157,7 @@ RunCommandLine parse_run_command(const std::vector<std::string>& args) {
   c.time_step = number_option(a, "time-step", false);
   c.width = int_option(a, "width", 16, 8192);
   c.height = int_option(a, "height", 16, 8192);
+  c.max_steps = number_option(a, "max-steps", false).value_or(kDefaultMaxSteps);
   c.frames = yes_no_option(a, "frames", true);
   c.quiet = yes_no_option(a, "quiet", false);
   return c;
@@ -143,26 +167,35 @@ const char* usage_text() {
   return "usage: odemag COMMAND [ARGS]\n"
          "\n"
          "commands:\n"
-         "  solve SCENE [--backend cpu|cuda|auto] [--threads N]\n"
+         "  solve SCENE [--backend cpu|cuda|auto] [--threads N] [--max-cell-pairs N]\n"
          "      Relax the magnetization with every body held in place and print JSON:\n"
          "      per body its cell count, moment (A m^2), force (N) and torque (N m),\n"
          "      all in the world frame, then the iteration count and the residual.\n"
-         "  field SCENE --points FILE [--backend cpu|cuda|auto] [--threads N]\n"
+         "  field SCENE --points FILE [--backend cpu|cuda|auto] [--threads N] [--max-cell-pairs N]\n"
          "      Relax as 'solve' does, then print CSV x,y,z,Bx,By,Bz,Hx,Hy,Hz (T, A/m)\n"
          "      at the points of FILE (lines 'x,y,z' in m; '-' reads standard input).\n"
          "  run SCENE --out DIR [--duration T] [--time-step DT] [--frame-rate F]\n"
          "                     [--frames yes|no] [--width W] [--height H] [--quiet yes|no]\n"
          "                     [--backend cpu|cuda|auto] [--threads N]\n"
+         "                     [--max-cell-pairs N] [--max-steps N]\n"
          "      Simulate with ODE for T s (default: the scene's simulation.duration) and\n"
          "      write to DIR: frame_NNNNN.png (when built with the renderer), state.jsonl\n"
          "      (one JSON line per frame: per body pose, velocities, moment, force,\n"
          "      torque) and summary.json (per-step T_m and T_r, iterations, outcomes).\n"
-         "      Files appear under their final names only when complete.\n"
+         "      Files appear under their final names only when complete; a previous\n"
+         "      run's frames, state.jsonl and summary.json in DIR are replaced (summary.json\n"
+         "      exists only after a run that finished).\n"
          "  help, --help\n"
          "      Print this text.\n"
          "\n"
          "--backend overrides the scene's solver.backend, --threads its solver.threads\n"
          "(0: all cores). Scene files are JSON in SI units (docs/scene-format.md).\n"
+         "\n"
+         "work limits: a scene whose field evaluation sums more than 1e8 cell pairs\n"
+         "(about 10,000 soft cells; raise with --max-cell-pairs N), or a run of more\n"
+         "than 1e7 rigid steps (duration / time step; raise with --max-steps N), is\n"
+         "refused with exit status 2 and an estimate of its cost. Long solves and runs\n"
+         "report their progress and an estimate of the time left on stderr.\n"
          "\n"
          "exit status: 0 done; 2 bad input or usage (one message on stderr naming the\n"
          "file and the offending key); 1 any other failure.\n";

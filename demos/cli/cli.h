@@ -46,11 +46,33 @@ struct Arguments {
 Arguments parse_arguments(const std::string& command, const std::vector<std::string>& args,
                           const std::vector<std::string>& known);
 
+// The work a command takes on without being told (usage_text, README "Using
+// it"): a scene beyond a limit is refused with exit 2 and the estimate; the
+// flags raise the limits.
+constexpr double kDefaultMaxCellPairs = 1e8;  // --max-cell-pairs: per field evaluation
+constexpr double kDefaultMaxSteps = 1e7;      // --max-steps: rigid steps of a run
+// Time per cell pair of one field evaluation on the reference machine, for
+// the estimates in messages (docs/benchmarks.md "5. Work limits": 4 to 6 ns).
+constexpr double kSecondsPerCellPair = 5e-9;
+
+// The command line of a program built on this parser (the demo programs,
+// demos/programs): `--help` or `-h` before any "--" prints usage to stdout
+// and returns 0; otherwise args are parsed with `known` and given to body,
+// whose status is returned. A UsageError from the parser or from body (which
+// checks its own options before writing anything) prints one line
+// "PROGRAM: MESSAGE" on stderr and returns 2.
+int program_main(const std::string& program, const char* usage, const std::vector<std::string>& args,
+                 const std::vector<std::string>& known, const std::function<int(const Arguments&)>& body);
+
 // Options shared by the commands that solve a scene.
 struct SolveOptions {
   std::optional<std::string> backend;  // --backend: overrides solver.backend
   std::optional<int> threads;          // --threads: overrides solver.threads
+  double max_cell_pairs = kDefaultMaxCellPairs;  // --max-cell-pairs
 };
+// Throws SceneError (exit 2, with the estimate) when one evaluation of the
+// scene's responsive field would sum more cell pairs than o.max_cell_pairs.
+void check_cell_pairs(const SceneDescription& scene, const SolveOptions& o);
 SolveOptions solve_options(const Arguments& args);
 
 // The whole command line of each command (args after the command word),
@@ -69,6 +91,7 @@ struct RunCommandLine {
   SolveOptions solve;
   std::optional<double> duration, frame_rate, time_step;  // override the scene's simulation.*
   std::optional<int> width, height;                       // override the scene's camera.*
+  double max_steps = kDefaultMaxSteps;                    // --max-steps
   bool frames = true, quiet = false;
 };
 SolveCommandLine parse_solve_command(const std::vector<std::string>& args);

@@ -71,22 +71,87 @@ class Progress {
     const size_t window = std::min<size_t>(r.size(), 100);
     for (size_t i = r.size() - window; i < r.size(); ++i) tm += r[i].magnetic_ms, tr += r[i].rigid_ms;
     if (window) tm /= static_cast<double>(window), tr /= static_cast<double>(window);
-    std::fprintf(stderr, "%sodemag run: t = %.3f / %.3f s (%3.0f%%), %ld steps, T_m %.2f ms, T_r %.2f ms per step%s",
+    // Time left at the pace so far.
+    const double elapsed = std::chrono::duration<double>(now - started_).count();
+    const double left = sim.time() > 0.0 ? elapsed * std::max(0.0, duration_ / sim.time() - 1.0) : 0.0;
+    std::fprintf(stderr,
+                 "%sodemag run: t = %.3f / %.3f s (%3.0f%%), %ld steps, T_m %.2f ms, T_r %.2f ms per step, "
+                 "%.0f s left%s",
                  tty_ ? "\r" : "", sim.time(), duration_, duration_ > 0 ? 100.0 * sim.time() / duration_ : 100.0,
-                 sim.steps(), tm, tr, tty_ && !last ? "" : "\n");
+                 sim.steps(), tm, tr, left, tty_ && !last ? "" : "\n");
     std::fflush(stderr);
   }
 
  private:
   double duration_;
   bool quiet_, tty_;
-  std::chrono::steady_clock::time_point shown_{};
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now(), shown_{};
 };
 
 std::string frame_name(int frame) {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%05d.png", frame);
   return name;
+}
+
+// A file name that frame_name gives.
+bool is_frame_name(const std::string& name) {
+  if (name.size() < 15 || name.rfind("frame_", 0) != 0 || name.compare(name.size() - 4, 4, ".png") != 0)
+    return false;
+  for (size_t i = 6; i + 4 < name.size(); ++i)
+    if (name[i] < '0' || name[i] > '9') return false;
+  return true;
+}
+
+// Refuses a run of more rigid steps than the limit (`--time-step 1e-12` ran
+// for ever): the scene's or the flag's time step is named.
+void check_step_count(const SceneDescription& scene, const RunCommandLine& c) {
+  const SimulationSettings& s = scene.simulation;
+  const double steps = std::ceil(s.duration / s.time_step - 0.5);
+  if (!(steps > c.max_steps)) return;
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "%.3g s over a duration of %.3g s is %.3g rigid steps, more than the limit %.3g; use a longer "
+                "time step or a shorter duration, or raise the limit with --max-steps N",
+                s.time_step, s.duration, steps, c.max_steps);
+  if (c.time_step) throw UsageError(std::string("--time-step: ") + text);
+  throw SceneError(scene.file, "simulation.time_step", text);
+}
+
+// The output directory, checked before anything is written: --out must be a
+// writable directory or not exist, and the run's file names in it must be
+// free for files (check_output_directory). Then, once the scene is built,
+// it is created (prepare_output_directory) and a previous run's frames, state.jsonl and summary.json are removed,
+// so that the directory never mixes two runs (`ffmpeg -i frame_%05d.png`
+// would read the stale frames of a longer earlier run).
+constexpr const char* kRunFiles[] = {"state.jsonl", "state.jsonl.partial", "summary.json"};
+
+void check_output_directory(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(dir, ec))) return;  // created by prepare_output_directory
+  if (!fs::is_directory(dir, ec)) throw UsageError("--out " + dir.string() + ": exists and is not a directory");
+  for (const char* name : kRunFiles) {
+    const fs::path p = dir / name;
+    if (fs::exists(fs::symlink_status(p, ec)) && !fs::is_regular_file(fs::symlink_status(p, ec)))
+      throw UsageError("--out " + dir.string() + ": " + p.string() + " exists and is not a file");
+  }
+  if (::access(dir.c_str(), W_OK) != 0) throw UsageError("--out " + dir.string() + ": the directory is not writable");
+}
+
+void prepare_output_directory(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw UsageError("--out " + dir.string() + ": cannot create the directory: " + ec.message());
+  std::vector<fs::path> previous;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+    if (is_frame_name(e.path().filename().string()) && e.is_regular_file(ec)) previous.push_back(e.path());
+  for (const char* name : kRunFiles)
+    if (fs::exists(dir / name, ec)) previous.push_back(dir / name);
+  for (const fs::path& p : previous)
+    if (!fs::remove(p, ec) || ec)
+      throw std::runtime_error("cannot remove the previous run's " + p.string() + ": " + ec.message());
 }
 
 }  // namespace
@@ -106,14 +171,16 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   const bool want_frames = c.frames;
   const bool quiet = c.quiet;
 
+  check_step_count(scene, c);
+  check_cell_pairs(scene, options);
+  const std::filesystem::path dir(out);
+  check_output_directory(dir);
+
   std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
   const std::string backend_name = backend->name();
   Simulation sim(scene, std::move(backend));
 
-  std::error_code ec;
-  std::filesystem::create_directories(out, ec);
-  if (ec) throw std::runtime_error("cannot create output directory " + out + ": " + ec.message());
-  const std::filesystem::path dir(out);
+  prepare_output_directory(dir);
   std::unique_ptr<FrameWriter> frame_writer;
   if (want_frames && frames) frame_writer = frames(scene);
   if (want_frames && !frame_writer)

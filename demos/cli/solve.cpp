@@ -1,5 +1,9 @@
 // `odemag solve` and `odemag field`: relax a scene with its bodies held in
 // place, then report per-body moments and forces, or the field at points.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -31,6 +35,55 @@ void require_finite(const SceneDescription& scene, bool finite) {
                              "solver.time_step_factor)");
 }
 
+// Progress lines of a relaxation that takes long: from 2 s on, every second
+// on a terminal (every 10 s otherwise), the iteration, the residual and the
+// iterations left at the rate the residual fell over the last five.
+class SolveProgress {
+ public:
+  SolveProgress(double tolerance, int max_iterations)
+      : tolerance_(tolerance), max_iterations_(max_iterations), tty_(isatty(STDERR_FILENO)) {}
+  void operator()(const RelaxReport& report) {
+    const auto now = std::chrono::steady_clock::now();
+    const double elapsed = std::chrono::duration<double>(now - started_).count();
+    const std::vector<double>& r = report.residual_history;
+    if (elapsed < 2.0 || now - shown_ < std::chrono::seconds(tty_ ? 1 : 10) || r.empty() || r.back() <= tolerance_)
+      return;
+    shown_ = now;
+    std::string left = "no estimate yet";
+    if (r.size() > 5 && r.back() > 0.0 && r[r.size() - 6] > 0.0) {
+      const double rate = std::log(r.back() / r[r.size() - 6]) / 5.0;  // log residual per iteration
+      const double per_iteration = elapsed / static_cast<double>(r.size());
+      if (rate < 0.0) {
+        const double more = std::min(std::ceil(std::log(tolerance_ / r.back()) / rate),
+                                     static_cast<double>(max_iterations_ - report.iterations));
+        char text[96];
+        std::snprintf(text, sizeof text, "about %.0f more iterations at the recent rate (~%.0f s)", more,
+                      more * per_iteration);
+        left = text;
+      } else {
+        left = "the residual is not falling";
+      }
+    }
+    std::fprintf(stderr, "odemag solve: iteration %d, residual %.2e (tolerance %.2e), %.0f s; %s\n",
+                 report.iterations, r.back(), tolerance_, elapsed, left.c_str());
+    std::fflush(stderr);
+  }
+
+ private:
+  double tolerance_;
+  int max_iterations_;
+  bool tty_;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now(), shown_{};
+};
+
+// The scene's relaxation options at t = 0, with the progress lines.
+RelaxOptions start_options(const SceneDescription& scene, MagneticSystem& system) {
+  RelaxOptions o = scene.solver.relax;
+  apply_events_at_start(scene, system, o);
+  o.progress = SolveProgress(o.tolerance, o.max_iterations);
+  return o;
+}
+
 std::string number(double x) { return nlohmann::json(x).dump(); }
 std::string vector(const Vec3& v) {
   std::string s = "[";
@@ -53,6 +106,21 @@ std::string scene_argument(const std::string& command, const Arguments& args) {
     throw UsageError("'" + command + "' takes one scene file; unexpected argument '" +
                      args.positional[1] + "'");
   return args.positional[0];
+}
+
+void check_cell_pairs(const SceneDescription& scene, const SolveOptions& o) {
+  const SceneCellCounts cells = count_scene_cells(scene);
+  const double pairs = cells.pairs_per_field_evaluation();
+  if (!(pairs > o.max_cell_pairs)) return;
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "one evaluation of the responsive field sums %.3g cell pairs (%.0f responsive cells, %.0f "
+                "magnetized), more than the limit %.3g: about %.2g s per evaluation on the 2-core reference "
+                "machine, and a relaxation takes tens of evaluations (up to solver.max_iterations = %d); "
+                "use a larger cell_size, or raise the limit with --max-cell-pairs N",
+                pairs, cells.responsive, cells.magnetized, o.max_cell_pairs, pairs * kSecondsPerCellPair,
+                scene.solver.relax.max_iterations);
+  throw SceneError(scene.file, "", text);
 }
 
 // The backend the options or the scene ask for. A fallback notice goes to
@@ -87,9 +155,11 @@ int run_solve(const std::vector<std::string>& args) {
   const SolveCommandLine c = parse_solve_command(args);
   const SolveOptions& options = c.solve;
   const SceneDescription scene = load_scene(c.scene);
+  check_cell_pairs(scene, options);
   MagneticSystem ms = build_magnetic_system(scene);
+  const RelaxOptions relax_options = start_options(scene, ms);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
-  const RelaxReport report = magnetic_step(ms.model, ms.state, scene.solver.relax, *backend);
+  const RelaxReport report = magnetic_step(ms.model, ms.state, relax_options, *backend);
 
   // One line per body, in scene order; bodies not present report zeros.
   bool finite = !std::isnan(report.residual);
@@ -125,10 +195,12 @@ int run_field(const std::vector<std::string>& args) {
   const SolveOptions& options = c.solve;
 
   const SceneDescription scene = load_scene(c.scene);
+  check_cell_pairs(scene, options);
   const std::vector<Vec3> points = read_points(c.points);
   MagneticSystem ms = build_magnetic_system(scene);
+  const RelaxOptions relax_options = start_options(scene, ms);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
-  const RelaxReport report = relax(ms.model, ms.state, scene.solver.relax, *backend);
+  const RelaxReport report = relax(ms.model, ms.state, relax_options, *backend);
   std::vector<Vec3> B, H;
   field_at_points(ms.model, ms.state, *backend, points, B, H);
 

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -45,14 +46,29 @@ namespace {
 
 using json = nlohmann::json;
 
-// A body's lattice may have at most this many points (bounding box / h^3):
-// beyond it the per-body tensors alone take gigabytes.
-constexpr double kMaxLatticePoints = 4194304.0;  // 2^22
-
 // The deepest scene value is 5 levels down (timeline[0].keys[0].position[0]);
 // deeper nesting is rejected while parsing, so that a file of a million '['
 // fails at once instead of building a million-level tree (docs/testing.md, fuzzing findings).
 constexpr size_t kMaxNesting = 64;
+
+// The largest magnitude a scene value of a kind may have (docs/scene-format.md
+// "Ranges"): far beyond anything physical, and small enough that every product
+// the model forms from it (moments M V, fields m / r^3, forces mu0 M^2 L^2,
+// masses rho V) stays finite. A magnetization of 1e160 A/m made moments whose
+// squares overflow: the relaxation failed instead of the loader naming the key.
+struct Magnitude {
+  double max = 0.0;  // 0: no bound
+  const char* unit = "";
+};
+constexpr Magnitude kFieldStrength{1e9, "A/m"};  // about 800 times the strongest magnets' 1.2e6 A/m
+constexpr Magnitude kLength{1e6, "m"};
+constexpr Magnitude kSpeed{1e8, "m/s"};
+constexpr Magnitude kAngularSpeed{1e8, "rad/s"};
+constexpr Magnitude kAcceleration{1e6, "m/s^2"};
+constexpr Magnitude kDensity{1e6, "kg/m^3"};
+// A shape's radius, side or length is at least this (its volume must not
+// underflow to a zero moment), m.
+constexpr double kMinSize = 1e-9;
 
 std::string member(const std::string& path, std::string_view key) {
   return path.empty() ? std::string(key) : path + "." + std::string(key);
@@ -68,6 +84,13 @@ std::string as_literal(const std::string& s) {
 }
 
 std::string format_number(double x) { return json(x).dump(); }
+
+// Three significant digits: 1e+09, 1.5e+160.
+std::string short_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", x);
+  return text;
+}
 
 // A first pass over the text (SAX: no tree is built) that checks what the
 // parser itself does not -- nesting depth, duplicate keys -- and, when the
@@ -199,6 +222,27 @@ class SceneReader {
     if (!(x >= lo && x <= hi))
       fail(path, "must be in " + format_number(lo) + ".." + format_number(hi) + ", got " +
                      format_number(x));
+    return x;
+  }
+
+  // x, or a failure when |x| exceeds the bound.
+  double bounded(double x, const std::string& path, const Magnitude& bound) const {
+    if (bound.max > 0.0 && std::abs(x) > bound.max)
+      fail(path, "magnitude " + short_number(std::abs(x)) + " " + bound.unit + " exceeds the largest accepted, " +
+                     short_number(bound.max) + " " + bound.unit + " (docs/scene-format.md \"Ranges\")");
+    return x;
+  }
+  // v, or a failure when its length exceeds the bound.
+  Vec3 bounded(const Vec3& v, const std::string& path, const Magnitude& bound) const {
+    if (bound.max <= 0.0) return v;
+    const double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    bounded(largest > bound.max ? largest : norm(v), path, bound);  // norm(v) cannot overflow here
+    return v;
+  }
+  // A shape's radius, side or length: kMinSize .. kLength.max, m.
+  double size(const json& v, const std::string& path) const {
+    const double x = bounded(positive(v, path), path, kLength);
+    if (x < kMinSize) fail(path, "must be at least " + format_number(kMinSize) + " m, got " + format_number(x));
     return x;
   }
 
@@ -342,6 +386,7 @@ struct KeyRule {
   Slot (*slot)(T&) = nullptr;                                                        // plain keys
   void (*read)(const SceneReader&, const json&, const std::string&, T&) = nullptr;  // Check::custom
   double lo = 0.0, hi = 0.0;                  // in_range, integer
+  Magnitude bound = {};                       // number, positive, non_negative, vec3: largest magnitude
   // choice: the words, then empty ones (a std::vector here crashes GCC 12).
   std::array<std::string_view, 4> words{};
   bool required = false;
@@ -397,9 +442,9 @@ void read_value(const SceneReader& r, const KeyRule<T>& rule, const json& x, con
   const Slot slot = rule.slot(target);
   const auto lo = static_cast<int>(rule.lo), hi = static_cast<int>(rule.hi);
   switch (rule.check) {
-    case Check::number: return store(slot, r.number(x, p));
-    case Check::positive: return store(slot, r.positive(x, p));
-    case Check::non_negative: return store(slot, r.non_negative(x, p));
+    case Check::number: return store(slot, r.bounded(r.number(x, p), p, rule.bound));
+    case Check::positive: return store(slot, r.bounded(r.positive(x, p), p, rule.bound));
+    case Check::non_negative: return store(slot, r.bounded(r.non_negative(x, p), p, rule.bound));
     case Check::in_range: return store(slot, r.in_range(x, p, rule.lo, rule.hi));
     case Check::integer: return store(slot, r.int_value(x, p, lo, hi));
     case Check::boolean: return store(slot, r.boolean(x, p));
@@ -411,8 +456,8 @@ void read_value(const SceneReader& r, const KeyRule<T>& rule, const json& x, con
         if (!w.empty()) words.push_back(w);
       return store(slot, r.choice(x, p, words));
     }
-    case Check::vec3: return store(slot, r.vec3(x, p));
-    case Check::non_zero_vec3: return store(slot, r.non_zero_vec3(x, p));
+    case Check::vec3: return store(slot, r.bounded(r.vec3(x, p), p, rule.bound));
+    case Check::non_zero_vec3: return store(slot, r.bounded(r.non_zero_vec3(x, p), p, rule.bound));
     case Check::color: return store(slot, r.color(x, p));
     case Check::quaternion: return store(slot, r.quaternion(x, p));
     case Check::custom: break;
@@ -461,7 +506,7 @@ struct MaterialTarget {
 
 const KeyTable<MaterialTarget<PermanentMaterial>> kPermanentKeys = {
     {.name = "type", .read = kReadBefore, .required = true, .doc = {"string", "", "**required**"}},
-    {.name = "magnetization", .check = Check::vec3, .slot = SLOT(material.magnetization), .required = true,
+    {.name = "magnetization", .check = Check::vec3, .slot = SLOT(material.magnetization), .bound = kFieldStrength, .required = true,
      .doc = {"vector", "A/m", "**required**"}},
     {.name = "recoil_susceptibility", .check = Check::non_negative, .slot = SLOT(material.recoil_susceptibility),
      .doc = {"number", "", "`0`"}},
@@ -471,7 +516,7 @@ const KeyTable<MaterialTarget<PermanentMaterial>> kPermanentKeys = {
 
 const KeyTable<MaterialTarget<SoftMaterial>> kSoftKeys = {
     {.name = "type", .read = kReadBefore, .required = true, .doc = {"string", "", "**required**"}},
-    {.name = "saturation", .check = Check::positive, .slot = SLOT(material.saturation), .required = true,
+    {.name = "saturation", .check = Check::positive, .slot = SLOT(material.saturation), .bound = kFieldStrength, .required = true,
      .doc = {"number", "A/m", "**required**"}},
     {.name = "susceptibility",
      .read = [](const SceneReader& r, const json& x, const std::string& p, MaterialTarget<SoftMaterial>& t) {
@@ -483,7 +528,7 @@ const KeyTable<MaterialTarget<SoftMaterial>> kSoftKeys = {
        }
      },
      .doc = {"number or `\"infinite\"`", "", "`\"infinite\"`"}},
-    {.name = "anisotropy_field", .check = Check::non_negative, .slot = SLOT(material.anisotropy_field),
+    {.name = "anisotropy_field", .check = Check::non_negative, .slot = SLOT(material.anisotropy_field), .bound = kFieldStrength,
      .doc = {"number", "A/m", "`0`"}},
     {.name = "easy_axis", .check = Check::non_zero_vec3, .slot = SLOT(material.easy_axis),
      .doc = {"vector", "", "`[0, 0, 1]`"}},
@@ -498,7 +543,7 @@ const KeyTable<MaterialTarget<SoftMaterial>> kSoftKeys = {
        t.material.moments_per_cell = n;
      },
      .doc = {"integer", "", "`2`"}},
-    {.name = "coil_field", .check = Check::vec3, .slot = SLOT(material.coil_field),
+    {.name = "coil_field", .check = Check::vec3, .slot = SLOT(material.coil_field), .bound = kFieldStrength,
      .doc = {"[x, y, z]", "A/m, body frame", "`[0, 0, 0]`"}},
     {.name = "color", .check = Check::color, .slot = SLOT(color),
      .doc = {"[r, g, b]", "", "material default"}},
@@ -543,21 +588,27 @@ Material read_material(const SceneReader& r, const json& v, const std::string& p
 using BodyIndex = std::map<std::string, size_t, std::less<>>;
 
 const KeyTable<Cylinder> kCylinderKeys = {
-    {.name = "radius", .check = Check::positive, .slot = SLOT(radius), .required = true},
-    {.name = "length", .check = Check::positive, .slot = SLOT(length), .required = true},
+    {.name = "radius", .read = [](const SceneReader& r, const json& x, const std::string& p, Cylinder& c) {
+       c.radius = r.size(x, p);
+     },
+     .required = true},
+    {.name = "length", .read = [](const SceneReader& r, const json& x, const std::string& p, Cylinder& c) {
+       c.length = r.size(x, p);
+     },
+     .required = true},
 };
 
 // Exactly one of these is present (read_shape).
 const KeyTable<Shape> kShapeKeys = {
     {.name = "sphere",
      .read = [](const SceneReader& r, const json& x, const std::string& p, Shape& s) {
-       s = Sphere{r.positive(x, p)};
+       s = Sphere{r.size(x, p)};
      }},
     {.name = "box",
      .read = [](const SceneReader& r, const json& x, const std::string& p, Shape& s) {
        r.require_array(x, p, 3);
        Box box;
-       for (size_t i = 0; i < 3; ++i) box.size[static_cast<int>(i)] = r.positive(x[i], element(p, i));
+       for (size_t i = 0; i < 3; ++i) box.size[static_cast<int>(i)] = r.size(x[i], element(p, i));
        s = box;
      }},
     {.name = "cylinder",
@@ -604,18 +655,18 @@ const KeyTable<BodyTarget> kBodyKeys = {
          r.fail(p, "no material named " + as_literal(t.body.material) + " in materials");
      },
      .required = true, .doc = {"string", "", "**required**"}},
-    {.name = "position", .check = Check::vec3, .slot = SLOT(body.position),
+    {.name = "position", .check = Check::vec3, .slot = SLOT(body.position), .bound = kLength,
      .doc = {"vector", "m", "`[0, 0, 0]`"}},
     {.name = "orientation", .check = Check::quaternion, .slot = SLOT(body.orientation),
      .doc = {"[w, x, y, z]", "", "`[1, 0, 0, 0]`"}},
-    {.name = "velocity", .check = Check::vec3, .slot = SLOT(body.velocity),
+    {.name = "velocity", .check = Check::vec3, .slot = SLOT(body.velocity), .bound = kSpeed,
      .doc = {"vector", "m/s", "`[0, 0, 0]`"}},
-    {.name = "angular_velocity", .check = Check::vec3, .slot = SLOT(body.angular_velocity),
+    {.name = "angular_velocity", .check = Check::vec3, .slot = SLOT(body.angular_velocity), .bound = kAngularSpeed,
      .doc = {"vector", "rad/s", "`[0, 0, 0]`"}},
     {.name = "fixed", .check = Check::boolean, .slot = SLOT(body.fixed), .doc = {"bool", "", "`false`"}},
-    {.name = "density", .check = Check::positive, .slot = SLOT(body.density),
+    {.name = "density", .check = Check::positive, .slot = SLOT(body.density), .bound = kDensity,
      .doc = {"number", "kg/m^3", "`1000`"}},
-    {.name = "cell_size", .check = Check::non_negative, .slot = SLOT(body.cell_size),
+    {.name = "cell_size", .check = Check::non_negative, .slot = SLOT(body.cell_size), .bound = kLength,
      .doc = {"number", "m", "see below"}},
     {.name = "present", .check = Check::boolean, .slot = SLOT(body.present),
      .doc = {"bool", "", "`true`"}},
@@ -629,20 +680,11 @@ BodyDescription read_body(const SceneReader& r, const json& v, const std::string
   read_object(r, v, path, kBodyKeys, t);
   BodyDescription& body = t.body;
 
-  // The lattice must stay a sensible size.
+  // The lattice must stay a sensible size (magnetics/model.h).
   const double h = lattice_spacing(body, scene.cell_size);
-  if (h > 0.0 && !is_inert(scene.materials.at(body.material))) {
-    const Vec3 half = shape_half_extents(body.shape);
-    double points = 1.0;
-    for (int a = 0; a < 3; ++a) points *= std::max(1.0, std::round(2.0 * half[a] / h));
-    if (points > kMaxLatticePoints) {
-      std::ostringstream msg;
-      msg.precision(3);
-      msg << "cell size " << format_number(h) << " gives body " << as_literal(body.name) << " a lattice of "
-          << points << " points; at most " << static_cast<long long>(kMaxLatticePoints) << " are allowed";
-      r.fail(body.cell_size ? member(path, "cell_size") : "cell_size", msg.str());
-    }
-  }
+  if (h > 0.0 && !is_inert(scene.materials.at(body.material)))
+    if (std::string e = validate_body_lattice(body.name, body.shape, h); !e.empty())
+      r.fail(body.cell_size ? member(path, "cell_size") : "cell_size", e);
   return body;
 }
 
@@ -708,7 +750,7 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
     {.name = "solver_iterations", .check = Check::integer, .slot = SLOT(solver_iterations), .lo = 1,
      .hi = 1000000, .doc = {"integer", "", "`30`"}},
     {.name = "ground", .check = Check::boolean, .slot = SLOT(ground), .doc = {"bool", "", "`true`"}},
-    {.name = "ground_height", .check = Check::number, .slot = SLOT(ground_height),
+    {.name = "ground_height", .check = Check::number, .slot = SLOT(ground_height), .bound = kLength,
      .doc = {"number", "m", "`0`"}},
     {.name = "contact",
      .read = [](const SceneReader& r, const json& x, const std::string& p, SimulationSettings& s) {
@@ -728,9 +770,9 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
 };
 
 const KeyTable<CameraSettings> kCameraKeys = {
-    {.name = "position", .check = Check::vec3, .slot = SLOT(position),
+    {.name = "position", .check = Check::vec3, .slot = SLOT(position), .bound = kLength,
      .doc = {"vector", "m", "`[0.3, -0.3, 0.2]`"}},
-    {.name = "target", .check = Check::vec3, .slot = SLOT(target),
+    {.name = "target", .check = Check::vec3, .slot = SLOT(target), .bound = kLength,
      .doc = {"vector", "m", "`[0, 0, 0.05]`"}},
     {.name = "up", .check = Check::non_zero_vec3, .slot = SLOT(up),
      .doc = {"vector", "", "`[0, 0, 1]`"}},
@@ -782,7 +824,7 @@ const KeyTable<KeyframeTarget> kKeyframeKeys = {
          r.fail(p, "key times must increase (previous key: " + format_number(t.previous->time) + ")");
      },
      .required = true},
-    {.name = "position", .check = Check::vec3, .slot = SLOT(key.position)},
+    {.name = "position", .check = Check::vec3, .slot = SLOT(key.position), .bound = kLength},
     {.name = "orientation", .check = Check::quaternion, .slot = SLOT(key.orientation)},
 };
 
@@ -848,7 +890,19 @@ const KeyTable<EventTarget> kScaleEventKeys = {
                        as_literal(t.body->material) + ")");
      },
      .required = true},
-    {.name = "to", .check = Check::number, .slot = SLOT(e.value), .required = true},
+    {.name = "to",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, EventTarget& t) {
+       t.e.value = r.number(x, p);
+       // The scaled magnetization (or coil field) stays within kFieldStrength.
+       const Material& material = t.scene.materials.at(t.body->material);
+       const PermanentMaterial* permanent = std::get_if<PermanentMaterial>(&material);
+       const Vec3 scaled = permanent ? permanent->magnetization : std::get<SoftMaterial>(material).coil_field;
+       const double largest = std::max({std::abs(scaled.x), std::abs(scaled.y), std::abs(scaled.z)});
+       if (std::abs(t.e.value) > kFieldStrength.max / largest)
+         r.fail(p, "scales the magnetization beyond the largest accepted, " + format_number(kFieldStrength.max) +
+                       " A/m (at most " + format_number(kFieldStrength.max / largest) + " for this body)");
+     },
+     .required = true},
     kEventEndTime,
 };
 
@@ -857,7 +911,7 @@ const KeyTable<EventTarget> kInductionEventKeys = {
     {.name = "enabled", .check = Check::boolean, .slot = SLOT(e.enabled), .required = true}};
 
 const KeyTable<EventTarget> kFieldEventKeys = {
-    kEventTime, kEventAction, {.name = "field", .check = Check::vec3, .slot = SLOT(e.field), .required = true},
+    kEventTime, kEventAction, {.name = "field", .check = Check::vec3, .slot = SLOT(e.field), .bound = kFieldStrength, .required = true},
     kEventEndTime};
 
 const KeyTable<EventTarget> kKeyframesEventKeys = {
@@ -910,7 +964,7 @@ TimelineEvent read_event(const SceneReader& r, const json& v, const std::string&
 
 const KeyTable<OutcomeDescription> kCountAboveKeys = {
     {.name = "prefix", .check = Check::string, .slot = SLOT(prefix), .required = true},
-    {.name = "height", .check = Check::number, .slot = SLOT(height), .required = true},
+    {.name = "height", .check = Check::number, .slot = SLOT(height), .bound = kLength, .required = true},
 };
 
 const KeyTable<OutcomeDescription> kOutcomeKeys = {
@@ -934,11 +988,11 @@ struct SceneTarget {
 const KeyTable<SceneTarget> kSceneKeys = {
     {.name = "title", .check = Check::string, .slot = SLOT(scene.title),
      .doc = {"string", "", "`\"\"`"}},
-    {.name = "gravity", .check = Check::vec3, .slot = SLOT(scene.gravity),
+    {.name = "gravity", .check = Check::vec3, .slot = SLOT(scene.gravity), .bound = kAcceleration,
      .doc = {"vector", "m/s^2", "`[0, 0, -9.81]`"}},
-    {.name = "external_field", .check = Check::vec3, .slot = SLOT(scene.external_field),
+    {.name = "external_field", .check = Check::vec3, .slot = SLOT(scene.external_field), .bound = kFieldStrength,
      .doc = {"vector", "A/m", "`[0, 0, 0]`"}},
-    {.name = "cell_size", .check = Check::non_negative, .slot = SLOT(scene.cell_size),
+    {.name = "cell_size", .check = Check::non_negative, .slot = SLOT(scene.cell_size), .bound = kLength,
      .doc = {"number", "m", "`0`"}},
     {.name = "seed",
      .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
@@ -1002,6 +1056,12 @@ const KeyTable<SceneTarget> kSceneKeys = {
        for (size_t i = 0; i < x.size(); ++i) {
          OutcomeDescription o;
          read_object(r, x[i], element(p, i), kOutcomeKeys, o);
+         // A prefix that names no body would count nothing, silently.
+         bool names_a_body = false;
+         for (const BodyDescription& body : t.scene.bodies) names_a_body = names_a_body || body.name.rfind(o.prefix, 0) == 0;
+         if (!names_a_body)
+           r.fail(member(member(element(p, i), "count_above"), "prefix"),
+                  "no body's name starts with " + as_literal(o.prefix));
          t.scene.outcomes.push_back(o);
          if (!names.insert(o.name).second)
            r.fail(member(element(p, i), "name"), "another outcome is already named " + as_literal(o.name));
@@ -1092,6 +1152,11 @@ std::vector<SceneKeyDoc> scene_key_docs() {
 }
 
 SceneDescription parse_scene(const std::string& json_text, const std::string& file) {
+  // The JSON parser takes a NUL byte for the end of the text: whatever follows
+  // it would be ignored.
+  if (const size_t nul = json_text.find('\0'); nul != std::string::npos)
+    throw SceneError(file, "", "invalid JSON: a NUL byte at offset " + std::to_string(nul) +
+                                   " (a scene file is JSON text)");
   PathTracker tracker(file);
   if (!json::sax_parse(json_text, &tracker)) {
     const std::string what = without_exception_tag(tracker.error().value_or("syntax error"));

@@ -2,7 +2,9 @@
 
 #include <stdexcept>
 
+#include "engine/sim/simulation.h"
 #include "gpu/cuda_backend.h"
+#include "magnetics/cells.h"
 
 namespace odemag {
 
@@ -36,6 +38,41 @@ MagneticSystem build_magnetic_system(const SceneDescription& scene) {
   }
   place_cells(ms.model, ms.state);
   return ms;
+}
+
+void apply_events_at_start(const SceneDescription& scene, MagneticSystem& system, RelaxOptions& options) {
+  for (const TimelineEvent& e : scene.timeline) {
+    const int body = e.body.empty() ? -1 : scene.find_body(e.body);
+    if (e.kind == TimelineEvent::Kind::keyframes) {
+      system.state.pose[body] = keyframe_pose(e.keys, 0.0);
+      continue;
+    }
+    if (e.time != 0.0 || e.end_time != 0.0) continue;  // later, or a ramp (at its start value at t = 0)
+    switch (e.kind) {
+      case TimelineEvent::Kind::add_body: system.state.active[body] = 1; break;
+      case TimelineEvent::Kind::remove_body: system.state.active[body] = 0; break;
+      case TimelineEvent::Kind::scale_magnetization: system.state.magnetization_scale[body] = e.value; break;
+      case TimelineEvent::Kind::mutual_induction: options.mutual_induction = e.enabled; break;
+      case TimelineEvent::Kind::external_field: system.state.external_field = e.field; break;
+      case TimelineEvent::Kind::keyframes: break;
+    }
+  }
+  place_cells(system.model, system.state);
+}
+
+SceneCellCounts count_scene_cells(const SceneDescription& scene) {
+  SceneCellCounts counts;
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    const BodyDescription& body = scene.bodies[b];
+    const Material& material = scene.materials.at(body.material);
+    if (is_inert(material)) continue;
+    const double h = scene.body_cell_size(static_cast<int>(b));
+    const double cells = h > 0.0 ? static_cast<double>(make_cells(body.shape, h).size()) : 1.0;
+    const auto* permanent = std::get_if<PermanentMaterial>(&material);
+    counts.magnetized += cells;
+    if (!permanent || permanent->recoil_susceptibility > 0.0) counts.responsive += cells;
+  }
+  return counts;
 }
 
 std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threads,

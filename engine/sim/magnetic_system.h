@@ -8,6 +8,7 @@
 #include "engine/scene/scene.h"
 #include "magnetics/backend.h"
 #include "magnetics/model.h"
+#include "magnetics/relax.h"
 #include "magnetics/state.h"
 
 namespace odemag {
@@ -21,6 +22,25 @@ struct MagneticSystem {
 
 // Throws SceneError naming the body when a shape or material is rejected.
 MagneticSystem build_magnetic_system(const SceneDescription& scene);
+
+// What the time line does at t = 0 (docs/scene-format.md "timeline"), applied
+// to a system built by build_magnetic_system and to the relaxation options:
+// events at time 0 that take no time (add, remove, scale_magnetization,
+// mutual_induction, external_field) and the keyframed bodies' poses at t = 0.
+// `odemag solve` and `field` report this state; a Simulation starts from it
+// (its constructor applies the same events to the ODE world).
+void apply_events_at_start(const SceneDescription& scene, MagneticSystem& system, RelaxOptions& options);
+
+// Cells the scene's magnetic model has, counted without building it (a
+// lattice body's tensors take time quadratic in its cells): every body,
+// present or added later. responsive: soft and recoil cells, which the
+// relaxation solves for; magnetized: those and the fixed magnets' cells.
+struct SceneCellCounts {
+  double responsive = 0.0, magnetized = 0.0;
+  // Cell pairs that one evaluation of the responsive field sums.
+  double pairs_per_field_evaluation() const { return responsive * magnetized; }
+};
+SceneCellCounts count_scene_cells(const SceneDescription& scene);
 
 // The body's pose in the scene description.
 BodyPose scene_pose(const BodyDescription& body);

@@ -118,6 +118,17 @@ void RigidWorld::set_enabled(int i, bool enabled) {
   }
 }
 
+void RigidWorld::set_kinematic(int i, bool kinematic) {
+  Body& b = bodies_[i];
+  if (b.kinematic == kinematic) return;
+  b.kinematic = kinematic;
+  if (kinematic) {
+    dBodySetKinematic(b.body);
+  } else {
+    dBodySetDynamic(b.body);
+  }
+}
+
 void RigidWorld::set_kinematic_state(int i, const BodyPose& pose, const Vec3& v, const Vec3& w) {
   dBodyID body = bodies_[i].body;
   dBodySetPosition(body, pose.position.x, pose.position.y, pose.position.z);

@@ -33,6 +33,10 @@ class RigidWorld {
   void set_enabled(int i, bool enabled);
   bool enabled(int i) const { return bodies_[i].enabled; }
 
+  // Makes a body kinematic (moved only by set_kinematic_state: a keyframed
+  // dynamic body while its track runs) or dynamic again, keeping its velocity.
+  void set_kinematic(int i, bool kinematic);
+
   // Places a kinematic body and gives it the velocities it moves with during
   // the next step (so contacts see the motion).
   void set_kinematic_state(int i, const BodyPose& pose, const Vec3& velocity, const Vec3& angular_velocity);

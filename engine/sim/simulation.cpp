@@ -84,6 +84,10 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
   event_state_.assign(scene_.timeline.size(), kPending);
   ramp_start_scale_.assign(scene_.timeline.size(), 1.0);
   ramp_start_field_.assign(scene_.timeline.size(), Vec3{});
+  // Events at t = 0 hold already in the state at t = 0 (frame 0, the first
+  // state line), as in `odemag solve` (apply_events_at_start); the first
+  // step() applies them again, which changes nothing.
+  apply_timeline(scene_.simulation.time_step);
 }
 
 void Simulation::apply_timeline(double dt) {
@@ -92,7 +96,16 @@ void Simulation::apply_timeline(double dt) {
     const int body = ev.body.empty() ? -1 : scene_.find_body(ev.body);
     if (ev.kind == TimelineEvent::Kind::keyframes) {
       // Scripted motion: place the body where the track says and give it the
-      // velocity that takes it to the next step's pose.
+      // velocity that takes it to the next step's pose. A body that is not
+      // fixed is kinematic while its track runs (held at the first key before
+      // it) and dynamic again after the last key, with the velocity of the
+      // track's last step (a hand that lets go); a fixed body stays at the
+      // last key.
+      if (!scene_.bodies[body].fixed) {
+        const bool released = time_ + 0.5 * dt >= ev.keys.back().time;
+        world_->set_kinematic(body, !released);
+        if (released) continue;
+      }
       const BodyPose now = keyframe_pose(ev.keys, time_);
       const BodyPose next = keyframe_pose(ev.keys, time_ + dt);
       world_->set_kinematic_state(body, now, (1.0 / dt) * (next.position - now.position),

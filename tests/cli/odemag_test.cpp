@@ -1,11 +1,10 @@
 // The odemag program end to end: runs bin/odemag on example and malformed
 // scenes and checks its output, its stderr and its exit status.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -16,6 +15,7 @@
 
 #include "magnetics/constants.h"
 #include "magnetics/vec3.h"
+#include "tests/support/program_run.h"
 
 namespace odemag {
 namespace {
@@ -26,30 +26,10 @@ using nlohmann::json;
 const std::string kOdemag = ODEMAG_BINARY_DIR "/bin/odemag";
 const std::string kExamples = ODEMAG_SOURCE_DIR "/examples/";
 
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::vector<std::string> lines(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) out.push_back(line);
-  return out;
-}
-
-struct ProgramRun {
-  int status = -1;  // exit status
-  std::string out, err;
-};
+using test_support::lines;
+using test_support::ProgramRun;
+using test_support::read_file;
+using test_support::shell_quote;
 
 // A scratch directory per test, removed at the end.
 class Cli : public ::testing::Test {
@@ -73,15 +53,7 @@ class Cli : public ::testing::Test {
 
   // Runs odemag with the (already quoted) arguments; stdin from `input`.
   ProgramRun odemag(const std::string& args, const std::string& input = "") {
-    const fs::path in = write("stdin.txt", input), out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = shell_quote(kOdemag) + " " + args + " <" + shell_quote(in) + " >" +
-                                shell_quote(out) + " 2>" + shell_quote(err);
-    const int raw = std::system(command.c_str());
-    ProgramRun r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = read_file(out);
-    r.err = read_file(err);
-    return r;
+    return test_support::run_program(shell_quote(kOdemag) + " " + args, dir_, write("stdin.txt", input));
   }
 
   // A malformed scene must give exit 2, no output and one stderr line naming
@@ -363,6 +335,185 @@ TEST_F(Cli, HelpExitsZero) {
     EXPECT_NE(r.out.find("solve"), std::string::npos);
     EXPECT_NE(r.out.find("field"), std::string::npos);
   }
+}
+
+// ---- what a new user tripped over: no quiet wrong answer, no hang, nothing half-written
+
+// Two one-cell balls, a magnet and a soft ball, on the CPU backend; `extra`
+// spliced in as further top-level keys, `magnet` as the magnet's material.
+std::string two_balls(const std::string& extra = "", const std::string& magnetization = "[0, 0, 1e6]",
+                      const std::string& radius = "0.01") {
+  return R"({"materials": {"m": {"type": "permanent", "magnetization": )" + magnetization + R"(},
+                           "s": {"type": "soft", "saturation": 1.6e6, "susceptibility": 1000}},
+             "solver": {"backend": "cpu"},
+             "bodies": [{"name": "magnet", "shape": {"sphere": 0.01}, "material": "m", "fixed": true},
+                        {"name": "ball_1", "shape": {"sphere": )" + radius + R"(}, "material": "s",
+                         "position": [0, 0, 0.03]}])" +
+         (extra.empty() ? "" : ", " + extra) + "}";
+}
+
+TEST_F(Cli, ValuesBeyondTheAcceptedMagnitudesExitTwoNamingTheKey) {
+  // Each made a relaxation of non-finite values (exit 1) or a quiet zero.
+  expect_rejected("magnetization.json", two_balls("", "[0, 0, 1e160]"), "materials.m.magnetization");
+  expect_rejected("huge_sphere.json", two_balls("", "[0, 0, 1e6]", "1e308"), "bodies[1].shape.sphere");
+  expect_rejected("tiny_sphere.json", two_balls("", "[0, 0, 1e6]", "1e-300"), "bodies[1].shape.sphere");
+  expect_rejected("field.json", two_balls(R"("external_field": [1e200, 0, 0])"), "external_field");
+  expect_rejected("gravity.json", two_balls(R"("gravity": [0, 0, -1e300])"), "gravity");
+  expect_rejected("scale.json",
+                  two_balls(R"("timeline": [{"time": 1, "action": "scale_magnetization", "body": "magnet",
+                                             "to": 1e300}])"),
+                  "timeline[0].to");
+  // The largest accepted values still solve.
+  const fs::path ok = write("largest.json", two_balls("", "[0, 0, 1e9]"));
+  const ProgramRun r = odemag("solve " + shell_quote(ok.string()));
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
+TEST_F(Cli, NulByteAfterTheJsonIsRejected) {
+  // The JSON parser stops at a NUL: what follows it was ignored.
+  const fs::path scene = write("nul2.json", two_balls() + std::string(1, '\0') + "garbage");
+  const ProgramRun r = odemag("solve " + shell_quote(scene.string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "");
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("odemag: " + scene.string() + ": invalid JSON: a NUL byte", 0), 0u) << r.err;
+}
+
+TEST_F(Cli, OutcomePrefixThatNamesNoBodyIsRejected) {
+  expect_rejected("prefix.json",
+                  two_balls(R"("outcomes": [{"name": "held", "count_above": {"prefix": "bal_", "height": 0}}])"),
+                  "outcomes[0].count_above.prefix");
+}
+
+TEST_F(Cli, FieldAcceptsSubnormalCoordinates) {
+  const fs::path scene = write("scene.json", two_balls());
+  const fs::path points = write("points.csv", "1e-320,0,0.05\n1e-400,0,0.05\n");
+  const ProgramRun r = odemag("field " + shell_quote(scene.string()) + " --points " + shell_quote(points.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = lines(r.out);
+  ASSERT_EQ(rows.size(), 3u);
+  // Both points are (0, 0, 0.05) to within rounding: the same Bz.
+  auto bz = [](const std::string& row) {
+    std::istringstream in(row);
+    std::string field;
+    for (int i = 0; i < 6; ++i) std::getline(in, field, ',');
+    return std::stod(field);
+  };
+  EXPECT_GT(bz(rows[1]), 0.01);
+  EXPECT_NEAR(bz(rows[1]), bz(rows[2]), 1e-12 * bz(rows[2]));
+}
+
+TEST_F(Cli, TooManyStepsAreRefusedWithTheEstimate) {
+  const fs::path scene = write("tiny_step.json", two_balls(R"("simulation": {"time_step": 1e-12, "duration": 1})"));
+  const fs::path out = dir_ / "out";
+  ProgramRun r = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()));
+  EXPECT_EQ(r.status, 2);  // it ran for ever
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("odemag: " + scene.string() + ": simulation.time_step: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("1e+12 rigid steps"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--max-steps"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // The flag's time step is named as the flag; --max-steps raises the limit.
+  const fs::path plain = write("plain.json", two_balls());
+  r = odemag("run " + shell_quote(plain.string()) + " --out " + shell_quote(out.string()) +
+             " --time-step 1e-4 --duration 0.1 --frames no --max-steps 100");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err.rfind("odemag: --time-step: ", 0), 0u) << r.err;
+  r = odemag("run " + shell_quote(plain.string()) + " --out " + shell_quote(out.string()) +
+             " --time-step 1e-4 --duration 0.1 --frames no --quiet yes --max-steps 1000");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(json::parse(read_file(out / "summary.json"))["steps"], 1000);
+}
+
+TEST_F(Cli, SolveAboveTheCellPairLimitIsRefusedWithTheEstimate) {
+  // A soft cube of 10^3 = 1000 cells: 1e6 cell pairs per field evaluation.
+  const std::string cube = R"({"materials": {"s": {"type": "soft", "saturation": 1.6e6, "susceptibility": 100}},
+      "external_field": [0, 0, 1000], "solver": {"backend": "cpu"},
+      "bodies": [{"name": "cube", "shape": {"box": [0.1, 0.1, 0.1]}, "material": "s", "cell_size": 0.01}]})";
+  const fs::path scene = write("cube.json", cube);
+  for (const std::string command : {"solve ", "field "}) {
+    const std::string points = command == "field " ? " --points " + shell_quote(write("p.csv", "0,0,1\n").string()) : "";
+    const ProgramRun r = odemag(command + shell_quote(scene.string()) + points + " --max-cell-pairs 1e5");
+    EXPECT_EQ(r.status, 2) << command;
+    EXPECT_EQ(r.out, "");
+    ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_NE(r.err.find("1e+06 cell pairs (1000 responsive cells"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--max-cell-pairs"), std::string::npos) << r.err;
+  }
+  const fs::path out = dir_ / "out";
+  const ProgramRun run = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) +
+                                " --max-cell-pairs 1e5");
+  EXPECT_EQ(run.status, 2);
+  EXPECT_FALSE(fs::exists(out));
+  // Within the default limit (1e8) it solves.
+  const ProgramRun ok = odemag("solve " + shell_quote(scene.string()));
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
+TEST_F(Cli, OutThatIsAFileOrHoldsADirectoryExitsTwoWritingNothing) {
+  const fs::path scene = write("scene.json", two_balls());
+  const fs::path file = write("a_file", "keep me");
+  ProgramRun r = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(file.string()) + " --frames no");
+  EXPECT_EQ(r.status, 2);  // was 1
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("odemag: --out " + file.string() + ": ", 0), 0u) << r.err;
+  EXPECT_EQ(read_file(file), "keep me");
+  // summary.json taken by a directory: refused before any frame or state line is written.
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out / "summary.json");
+  r = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) + " --duration 0.1");
+  EXPECT_EQ(r.status, 2);  // was 1, with frames and state.jsonl left behind
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("summary.json exists and is not a file"), std::string::npos) << r.err;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
+  EXPECT_EQ(names, std::vector<std::string>{"summary.json"});
+}
+
+TEST_F(Cli, RerunIntoTheSameOutReplacesThePreviousRunsFiles) {
+  const fs::path scene = write("scene.json", two_balls());
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  // A longer earlier run's frames, and a file that is not odemag's.
+  for (const char* name : {"frame_00000.png", "frame_00007.png", "frame_12345.png"}) write("out/" + std::string(name), "old");
+  write("out/notes.txt", "mine");
+  const ProgramRun r = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) +
+                              " --duration 0.1 --frame-rate 10 --frames no --quiet yes");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"notes.txt", "state.jsonl", "summary.json"}));
+  EXPECT_EQ(lines(read_file(out / "state.jsonl")).size(), 2u);
+}
+
+TEST_F(Cli, EventsAtTimeZeroShowInSolveAndInTheFirstStateLine) {
+  // The magnet switched off and the ball removed at t = 0, an external field set.
+  const std::string events = R"("timeline": [
+      {"time": 0, "action": "scale_magnetization", "body": "magnet", "to": 0},
+      {"time": 0, "action": "external_field", "field": [0, 0, 1000]}])";
+  const fs::path scene = write("scene.json", two_balls(events));
+  const ProgramRun solved = odemag("solve " + shell_quote(scene.string()));
+  ASSERT_EQ(solved.status, 0) << solved.err;
+  const json j = json::parse(solved.out);
+  EXPECT_EQ(vec(j["bodies"][0]["moment"]).z, 0.0);  // the magnet is off
+  // The ball feels H_E alone: m = 3 V H_E / (1 + 3 / chi) for a sphere.
+  const double V = 4.0 / 3.0 * kPi * 1e-6, m = 3.0 * V * 1000.0 / (1.0 + 3.0 / 1000.0);
+  EXPECT_NEAR(vec(j["bodies"][1]["moment"]).z, m, 1e-3 * m);
+  const fs::path out = dir_ / "out";
+  const ProgramRun run = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) +
+                                " --duration 0 --frames no --quiet yes");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const json frame0 = json::parse(lines(read_file(out / "state.jsonl")).at(0));
+  EXPECT_EQ(vec(frame0["bodies"][0]["moment"]).z, 0.0);
+  EXPECT_NEAR(vec(frame0["bodies"][1]["moment"]).z, m, 1e-3 * m);
+  // An add at t = 0 of a body not present shows it present.
+  const std::string add = R"({"materials": {"s": {"type": "soft", "saturation": 1.6e6}}, "solver": {"backend": "cpu"},
+      "bodies": [{"name": "b", "shape": {"sphere": 0.01}, "material": "s", "present": false}],
+      "timeline": [{"time": 0, "action": "add", "body": "b"}]})";
+  const ProgramRun added = odemag("solve " + shell_quote(write("add.json", add).string()));
+  ASSERT_EQ(added.status, 0) << added.err;
+  EXPECT_TRUE(json::parse(added.out)["bodies"][0]["present"].get<bool>());
 }
 
 }  // namespace

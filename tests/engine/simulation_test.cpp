@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "engine/sim/magnetic_system.h"
 #include "magnetics/constants.h"
 #include "tests/support/scene_builders.h"
 
@@ -214,6 +215,81 @@ TEST(Timeline, KeyframedBodyFollowsItsTrack) {
   EXPECT_NEAR(p.position.z, 0.15, 1e-9);
   // Half-way the orientation is a rotation by 0.5 rad about z.
   EXPECT_NEAR(std::atan2(p.rotation.m[1][0], p.rotation.m[0][0]), 0.5, 1e-6);
+}
+
+// A body that is not fixed follows its track while the track runs and is
+// free after the last key, with the track's last velocity (it was held at
+// the last key for good, a kinematic body without a word).
+TEST(Timeline, KeyframedDynamicBodyIsReleasedAfterItsLastKey) {
+  SceneDescription s;
+  s.file = "throw";
+  s.gravity = {0, 0, -9.81};
+  s.simulation.ground = false;
+  s.simulation.time_step = 0.001;
+  s.materials["wood"] = InertMaterial{};
+  s.bodies.push_back(body("ball", Sphere{0.01}, "wood", {0, 0, 1.0}, false));
+  TimelineEvent keys;
+  keys.kind = TimelineEvent::Kind::keyframes;
+  keys.body = "ball";
+  keys.keys = {{0.0, {0, 0, 1.0}, {}}, {0.2, {0.2, 0, 1.0}, {}}};  // 1 m/s along x, no fall
+  keys.time = 0.0;
+  keys.end_time = 0.2;
+  s.timeline = {keys};
+  Simulation sim(s);
+  sim.advance_to(0.1);
+  EXPECT_NEAR(sim.world().pose(0).position.x, 0.1, 1e-9);
+  EXPECT_NEAR(sim.world().pose(0).position.z, 1.0, 1e-9);  // gravity does not act on the track
+  sim.advance_to(0.5);
+  // Released at t = 0.2 s with v = (1, 0, 0): a throw, 0.3 s of free flight.
+  const double t = 0.3;
+  EXPECT_NEAR(sim.world().pose(0).position.x, 0.2 + 1.0 * t, 2e-3);
+  EXPECT_NEAR(sim.world().pose(0).position.z, 1.0 - 0.5 * 9.81 * t * t, 5e-3);
+  EXPECT_NEAR(sim.world().velocity(0).z, -9.81 * t, 2e-2);
+  EXPECT_FALSE(sim.world().kinematic(0));
+}
+
+// Events at t = 0 hold in the state at t = 0, before the first step (frame 0
+// and the first state line of `odemag run`), as apply_events_at_start gives
+// `odemag solve`.
+TEST(Timeline, EventsAtTimeZeroHoldBeforeTheFirstStep) {
+  SceneDescription s = weightless_scene("events_at_zero");
+  s.materials["magnet"] = PermanentMaterial{{0, 0, 1e6}, 0.0};
+  s.materials["steel"] = steel();
+  s.bodies.push_back(body("magnet", Sphere{0.01}, "magnet", {0, 0, 0}, true));
+  s.bodies.push_back(body("ball", Sphere{0.005}, "steel", {0, 0, 0.03}, true));
+  s.bodies.push_back(body("other", Sphere{0.005}, "steel", {0.05, 0, 0}, true));
+  TimelineEvent off;
+  off.kind = TimelineEvent::Kind::scale_magnetization;
+  off.body = "magnet";
+  off.value = 0.0;
+  TimelineEvent remove;
+  remove.kind = TimelineEvent::Kind::remove_body;
+  remove.body = "other";
+  TimelineEvent field;
+  field.kind = TimelineEvent::Kind::external_field;
+  field.field = {0, 0, 1000};
+  s.timeline = {off, remove, field};
+  Simulation sim(s);
+  EXPECT_EQ(sim.magnetics().magnetization_scale(0), 0.0);
+  EXPECT_FALSE(sim.magnetics().active(2));
+  EXPECT_FALSE(sim.world().enabled(2));
+  EXPECT_EQ(sim.magnetics().external_field().z, 1000.0);
+
+  MagneticSystem system = build_magnetic_system(s);
+  RelaxOptions options = s.solver.relax;
+  apply_events_at_start(s, system, options);
+  EXPECT_EQ(system.state.magnetization_scale[0], 0.0);
+  EXPECT_EQ(system.state.active[2], 0);
+  EXPECT_EQ(system.state.external_field.z, 1000.0);
+  // The relaxed moments agree: the ball feels only H_E.
+  sim.magnetics().compute();
+  auto backend = make_cpu_backend(1);
+  magnetic_step(system.model, system.state, options, *backend);
+  EXPECT_NEAR(body_moment(system.model, system.state, 1).z, sim.magnetics().moment(1).z,
+              1e-6 * std::abs(sim.magnetics().moment(1).z));
+  // A sphere of chi -> large in H_E: m = 3 V H_E (its demagnetising factor 1/3).
+  const double V = 4.0 / 3.0 * kPi * std::pow(0.005, 3);
+  EXPECT_NEAR(body_moment(system.model, system.state, 1).z, 3.0 * V * 1000.0, 0.01 * 3.0 * V * 1000.0);
 }
 
 }  // namespace

@@ -547,3 +547,37 @@ TEST(RecoilMagnet, OneCellMatchesLinearSphere) {
 
 }  // namespace
 }  // namespace odemag
+
+namespace odemag {
+namespace {
+
+// RelaxOptions::progress (the progress lines of a long `odemag solve`) is
+// called once after every outer iteration, with the residuals so far, for the
+// two-level and the paper scheme.
+TEST(Relax, ProgressIsReportedAfterEveryOuterIteration) {
+  for (const RelaxScheme scheme : {RelaxScheme::two_level, RelaxScheme::paper}) {
+    MagneticModel model;
+    SoftMaterial iron;
+    iron.saturation = 1.6e6;
+    iron.susceptibility = 100.0;
+    model.add_body("cube", Box{{0.01, 0.01, 0.01}}, iron, 0.0025);
+    MagneticState state = make_state(model, 1);
+    state.external_field = {0, 0, 1e4};
+    RelaxOptions o;
+    o.scheme = scheme;
+    std::vector<std::vector<double>> seen;
+    o.progress = [&](const RelaxReport& r) {
+      EXPECT_EQ(r.residual_history.size(), seen.size() + 1);
+      seen.push_back(r.residual_history);
+    };
+    auto backend = make_cpu_backend(1);
+    o.max_iterations = 40;  // the paper scheme need not converge in these
+    const RelaxReport report = relax(model, state, o, *backend);
+    ASSERT_FALSE(seen.empty());
+    EXPECT_EQ(seen.size(), report.residual_history.size());
+    EXPECT_EQ(seen.back(), report.residual_history);
+  }
+}
+
+}  // namespace
+}  // namespace odemag
