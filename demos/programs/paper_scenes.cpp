@@ -2,10 +2,12 @@
 // OUT/<scene>/ (frames, state.jsonl, summary.json); then the outcomes next to
 // what the paper reports. Usage:
 //   demo_paper_scenes [--out DIR] [--only NAME] [--frames yes|no]
+// --out defaults to ./out, --only to every scene, --frames to yes. --help or
+// -h prints the usage; a bad command line exits 2 with one line on stderr,
+// before anything is written.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,8 @@
 #include "demos/cli/cli.h"
 
 namespace {
+
+using odemag::cli::UsageError;
 
 struct PaperScene {
   const char* name;
@@ -33,29 +37,45 @@ const PaperScene kScenes[] = {
     {"crane", "Fig. 17: the crane holds fewer balls as its magnetization falls, a few when off"},
 };
 
-}  // namespace
+const char kUsage[] =
+    "usage: demo_paper_scenes [--out DIR] [--only NAME] [--frames yes|no]\n"
+    "  Simulates the paper's scenes with `odemag run` into DIR/<scene>/ (default\n"
+    "  DIR: out) and prints each outcome next to the paper's claim.\n"
+    "  --only NAME: that scene only; --frames no: no PNG frames.\n";
 
-int main(int argc, char** argv) {
+struct Options {
   std::string out = "out", only, frames = "yes";
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i], value = argv[i + 1];
-    if (key == "--out") out = value;
-    else if (key == "--only") only = value;
-    else if (key == "--frames") frames = value;
-    else {
-      std::fprintf(stderr, "usage: demo_paper_scenes [--out DIR] [--only NAME] [--frames yes|no]\n");
-      return 2;
+};
+
+// The options, checked before anything is written; throws UsageError.
+Options read_options(const odemag::cli::Arguments& a) {
+  if (!a.positional.empty()) throw UsageError("unexpected argument '" + a.positional[0] + "'");
+  Options o;
+  o.out = a.option("out").value_or(o.out);
+  o.frames = a.option("frames").value_or(o.frames);
+  if (o.out.empty()) throw UsageError("--out must not be empty");
+  if (o.frames != "yes" && o.frames != "no") throw UsageError("--frames must be yes or no, not '" + o.frames + "'");
+  if (const auto only = a.option("only")) {
+    std::string names;
+    for (const PaperScene& s : kScenes) {
+      if (*only == s.name) o.only = *only;
+      names += (names.empty() ? "" : ", ") + std::string(s.name);
     }
+    if (o.only.empty()) throw UsageError("unknown scene '" + *only + "' for --only (scenes: " + names + ")");
   }
+  return o;
+}
+
+int run_scenes(const Options& opt) {
   int status = 0;
   for (const PaperScene& s : kScenes) {
-    if (!only.empty() && only != s.name) continue;
+    if (!opt.only.empty() && opt.only != s.name) continue;
     const std::string scene = std::string(ODEMAG_SCENES_DIR) + "/" + s.name + ".json";
-    const std::string dir = (std::filesystem::path(out) / s.name).string();
+    const std::string dir = (std::filesystem::path(opt.out) / s.name).string();
     std::printf("== %s: %s\n", s.name, s.claim);
     std::fflush(stdout);
     try {
-      const int rc = odemag::cli::run_simulation({scene, "--out", dir, "--frames", frames, "--quiet", "yes"},
+      const int rc = odemag::cli::run_simulation({scene, "--out", dir, "--frames", opt.frames, "--quiet", "yes"},
                                                  odemag::make_png_frame_writer);
       if (rc != 0) status = rc;
       std::ifstream in(std::filesystem::path(dir) / "summary.json");
@@ -70,4 +90,11 @@ int main(int argc, char** argv) {
     }
   }
   return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return odemag::cli::program_main("demo_paper_scenes", kUsage, {argv + 1, argv + argc}, {"out", "only", "frames"},
+                                   [](const odemag::cli::Arguments& a) { return run_scenes(read_options(a)); });
 }
