@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages odemag needs, only those that are missing.
 # Runs as root (or with sudo). Usage: scripts/install-deps.sh [--sanitize] [extra packages...]
+# (scripts/demo.sh adds ffmpeg for its video; the tests do not need it).
 # --sanitize adds what scripts/sanitize.sh needs: clang-14 with libFuzzer and
 # the sanitizer runtimes, and clang's OpenMP (libomp) for the fuzz build.
 set -euo pipefail
@@ -14,6 +15,7 @@ fi
 packages=(
   build-essential cmake pkg-config
   libode-dev libeigen3-dev libosmesa6-dev libpng-dev nlohmann-json3-dev
+  libfreetype-dev fonts-dejavu-core
   libgtest-dev libbenchmark-dev
   gnuplot-nox
   "${sanitize_packages[@]}"

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 
 #include "demos/cli/cli.h"
 
@@ -145,7 +146,7 @@ RunCommandLine parse_run_command(const std::vector<std::string>& args) {
   const Arguments a = parse_arguments(
       "run", args,
       {"out", "duration", "frame-rate", "time-step", "frames", "width", "height", "backend", "threads", "quiet",
-       "max-cell-pairs", "max-steps"});
+       "max-cell-pairs", "max-steps", "state-every-step", "video"});
   RunCommandLine c;
   c.scene = scene_argument("run", a);
   const auto out = a.option("out");
@@ -160,6 +161,14 @@ RunCommandLine parse_run_command(const std::vector<std::string>& args) {
   c.max_steps = number_option(a, "max-steps", false).value_or(kDefaultMaxSteps);
   c.frames = yes_no_option(a, "frames", true);
   c.quiet = yes_no_option(a, "quiet", false);
+  c.state_every_step = yes_no_option(a, "state-every-step", false);
+  if (const auto video = a.option("video")) {  // encoded in run.cpp (encode_video)
+    const std::string ext = std::filesystem::path(*video).extension().string();
+    if (ext != ".mp4" && ext != ".gif")
+      throw UsageError("--video " + *video + ": the file name must end in .mp4 or .gif");
+    if (!c.frames) throw UsageError("--video is made from the frames: it cannot go with --frames no");
+    c.video = *video;
+  }
   return c;
 }
 
@@ -177,14 +186,19 @@ const char* usage_text() {
          "  run SCENE --out DIR [--duration T] [--time-step DT] [--frame-rate F]\n"
          "                     [--frames yes|no] [--width W] [--height H] [--quiet yes|no]\n"
          "                     [--backend cpu|cuda|auto] [--threads N]\n"
-         "                     [--max-cell-pairs N] [--max-steps N]\n"
+         "                     [--max-cell-pairs N] [--max-steps N] [--video FILE]\n"
+         "                     [--state-every-step yes|no]\n"
          "      Simulate with ODE for T s (default: the scene's simulation.duration) and\n"
          "      write to DIR: frame_NNNNN.png (when built with the renderer), state.jsonl\n"
-         "      (one JSON line per frame: per body pose, velocities, moment, force,\n"
+         "      (one JSON line per frame, or per rigid step with --state-every-step yes:\n"
+         "      the step, the frame, the time, per body pose, velocities, moment, force,\n"
          "      torque) and summary.json (per-step T_m and T_r, iterations, outcomes).\n"
          "      Files appear under their final names only when complete; a previous\n"
          "      run's frames, state.jsonl and summary.json in DIR are replaced (summary.json\n"
          "      exists only after a run that finished).\n"
+         "      --video FILE.mp4 or FILE.gif (relative to the current directory, not to\n"
+         "      DIR) also encodes the frames at the frame rate with the ffmpeg program\n"
+         "      (apt-get install ffmpeg): H.264 MP4 or a paletted GIF; the PNG frames stay.\n"
          "  help, --help\n"
          "      Print this text.\n"
          "\n"

@@ -93,6 +93,10 @@ struct RunCommandLine {
   std::optional<int> width, height;                       // override the scene's camera.*
   double max_steps = kDefaultMaxSteps;                    // --max-steps
   bool frames = true, quiet = false;
+  bool state_every_step = false;  // --state-every-step: a state line after every rigid step, not only per frame
+  // --video FILE.mp4|FILE.gif (relative to the current directory): the frames
+  // encoded by the ffmpeg program after the run; needs the frames.
+  std::optional<std::string> video;
 };
 SolveCommandLine parse_solve_command(const std::vector<std::string>& args);
 FieldCommandLine parse_field_command(const std::vector<std::string>& args);

@@ -1,12 +1,19 @@
 // `odemag run SCENE --out DIR`: simulate with ODE and write per-frame state,
-// frames (when a renderer is available) and a summary (docs/hard-cases.md
-// "Output safety").
+// frames (when a renderer is available), a video of them (--video) and a
+// summary (docs/hard-cases.md "Output safety").
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <numeric>
 
@@ -14,6 +21,8 @@
 
 #include "demos/cli/cli.h"
 #include "engine/sim/simulation.h"
+
+extern char** environ;
 
 namespace odemag::cli {
 
@@ -34,7 +43,10 @@ json statistics(std::vector<double> x) {
           {"total", total}};
 }
 
-json frame_state(const Simulation& sim, int frame) {
+// One state line: the step count, the frame number when the line is a frame
+// (frame < 0: a step between frames, --state-every-step), the time, per body
+// its pose, velocities, moment, force and torque.
+json state_line(const Simulation& sim, int frame) {
   json bodies = json::array();
   const SceneDescription& scene = sim.scene();
   for (int b = 0; b < sim.world().body_count(); ++b) {
@@ -49,7 +61,11 @@ json frame_state(const Simulation& sim, int frame) {
                       {"force", vec(sim.magnetics().force(b))},
                       {"torque", vec(sim.magnetics().torque(b))}});
   }
-  return {{"frame", frame}, {"time", sim.time()}, {"bodies", bodies}};
+  json line = {{"step", sim.steps()}};
+  if (frame >= 0) line["frame"] = frame;
+  line["time"] = sim.time();
+  line["bodies"] = bodies;
+  return line;
 }
 
 // Stops the run when a body's state is NaN or infinite; nothing of that step
@@ -154,6 +170,99 @@ void prepare_output_directory(const std::filesystem::path& dir) {
       throw std::runtime_error("cannot remove the previous run's " + p.string() + ": " + ec.message());
 }
 
+// --video (issue 16 item 3): the frames encoded by the ffmpeg program.
+
+// The file that posix_spawnp would run for `name`: the first executable
+// PATH/name (PATH unset: execvp's default /bin:/usr/bin); "" when none.
+std::string find_program(const std::string& name) {
+  const char* env = std::getenv("PATH");
+  const std::string path = env ? env : "/bin:/usr/bin";
+  for (size_t start = 0;;) {
+    const size_t end = path.find(':', start);
+    const std::string dir = path.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    const std::string file = (dir.empty() ? "." : dir) + "/" + name;
+    struct stat st {};
+    if (::stat(file.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(file.c_str(), X_OK) == 0) return file;
+    if (end == std::string::npos) return "";
+    start = end + 1;
+  }
+}
+
+// p absolute, normalized, without a trailing '/'.
+std::filesystem::path normal(const std::filesystem::path& p) {
+  std::filesystem::path n = std::filesystem::absolute(p).lexically_normal();
+  return n.has_filename() ? n : n.parent_path();
+}
+
+// Checks --video before anything is written (exit 2) and returns the ffmpeg
+// to run: ffmpeg on PATH, a build with the renderer, and the video's
+// directory writable or --out (which the run creates).
+std::string check_video(const RunCommandLine& c, bool renderer) {
+  namespace fs = std::filesystem;
+  const std::string& video = *c.video;
+  const std::string ffmpeg = find_program("ffmpeg");
+  if (ffmpeg.empty())
+    throw UsageError("--video " + video + ": needs the ffmpeg program, which is not on PATH; install ffmpeg "
+                     "(apt-get install ffmpeg) or leave out --video");
+  if (!renderer) throw UsageError("--video " + video + ": this build has no renderer, so there are no frames to encode");
+  std::error_code ec;
+  const fs::path file = normal(video), parent = file.parent_path();
+  if (fs::is_directory(file, ec)) throw UsageError("--video " + video + ": is a directory");
+  if (parent != normal(c.out) && (!fs::is_directory(parent, ec) || ::access(parent.c_str(), W_OK) != 0))
+    throw UsageError("--video " + video + ": " + parent.string() + " is not a writable directory");
+  return ffmpeg;
+}
+
+// Runs the program with argv `args`, without a shell; its exit status (a
+// signal: 128 + the signal number).
+int run_program(const std::string& program, std::vector<std::string> args) {
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (const int err = posix_spawn(&pid, program.c_str(), nullptr, nullptr, argv.data(), environ); err != 0)
+    throw std::runtime_error("cannot run " + program + ": " + std::strerror(err));
+  int raw = 0;
+  while (waitpid(pid, &raw, 0) < 0)
+    if (errno != EINTR) throw std::runtime_error("waiting for " + program + ": " + std::strerror(errno));
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+}
+
+// Encodes DIR/frame_NNNNN.png at `rate` frames per second: MP4 as H.264
+// yuv420p (padded to even dimensions, which yuv420p needs), GIF through a
+// palette made from the frames. ffmpeg writes VIDEO.tmp-PID, renamed over
+// VIDEO only when it succeeded (docs/hard-cases.md "Output safety").
+void encode_video(const std::string& ffmpeg, const std::filesystem::path& dir, const std::string& video,
+                  double rate) {
+  // Absolute paths: a name starting with '-' is no option and one with ':'
+  // no protocol to ffmpeg; '%' in DIR is escaped for the image2 pattern.
+  std::string pattern;
+  for (char ch : normal(dir).string()) pattern += ch == '%' ? std::string("%%") : std::string(1, ch);
+  pattern += "/frame_%05d.png";
+  const std::string path = normal(video).string(), temporary = path + ".tmp-" + std::to_string(getpid());
+  char fps[32];
+  std::snprintf(fps, sizeof fps, "%.10g", rate);
+  std::vector<std::string> args = {ffmpeg, "-nostdin", "-hide_banner", "-loglevel", "error", "-y",
+                                   "-framerate", fps, "-i", pattern};
+  const std::vector<std::string> format =
+      std::filesystem::path(video).extension() == ".gif"
+          ? std::vector<std::string>{"-vf", "split[a][b];[a]palettegen[p];[b][p]paletteuse", "-f", "gif"}
+          : std::vector<std::string>{"-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt",
+                                     "yuv420p", "-f", "mp4"};
+  args.insert(args.end(), format.begin(), format.end());
+  args.push_back(temporary);
+  const int status = run_program(ffmpeg, args);
+  const int fd = status == 0 ? ::open(temporary.c_str(), O_RDONLY | O_CLOEXEC) : -1;
+  const bool synced = fd >= 0 && ::fsync(fd) == 0;
+  if (fd >= 0) ::close(fd);
+  if (!synced || std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const std::string why = status != 0 ? "ffmpeg failed (exit status " + std::to_string(status) + ")"
+                                        : "cannot write " + temporary + ": " + std::strerror(errno);
+    ::unlink(temporary.c_str());
+    throw std::runtime_error("--video " + video + ": " + why + "; the frames are in " + dir.string());
+  }
+}
+
 }  // namespace
 
 int run_simulation(const std::vector<std::string>& args, const FrameWriterFactory& frames) {
@@ -175,6 +284,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   check_cell_pairs(scene, options);
   const std::filesystem::path dir(out);
   check_output_directory(dir);
+  const std::string ffmpeg = c.video ? check_video(c, static_cast<bool>(frames)) : "";
 
   std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
   const std::string backend_name = backend->name();
@@ -192,7 +302,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   int frame = 0;
   double next_frame_time = 0.0;
   auto emit_frame = [&] {
-    state_file.append(frame_state(sim, frame).dump() + "\n");
+    state_file.append(state_line(sim, frame).dump() + "\n");
     if (frame_writer) frame_writer->write(sim, (dir / frame_name(frame)).string());
     ++frame;
     next_frame_time = frame / settings.frame_rate;
@@ -202,12 +312,17 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   while (sim.time() + 0.5 * settings.time_step < settings.duration) {
     sim.step();
     check_finite(sim);
-    if (sim.time() + 0.5 * settings.time_step >= next_frame_time) emit_frame();
+    if (sim.time() + 0.5 * settings.time_step >= next_frame_time) {
+      emit_frame();
+    } else if (c.state_every_step) {
+      state_file.append(state_line(sim, -1).dump() + "\n");
+    }
     progress.update(sim);
   }
   sim.finish();
   state_file.finish();
   progress.update(sim, true);
+  if (c.video) encode_video(ffmpeg, dir, *c.video, settings.frame_rate);  // before summary.json: a finished run
 
   // summary.json: the cost of every rigid step and the scene's outcomes.
   std::vector<double> tm, tr, iterations, substeps;
@@ -223,7 +338,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   const MagneticModel& model = sim.magnetics().model();
   json outcomes = json::object();
   for (const auto& [name, value] : sim.outcomes()) outcomes[name] = value;
-  const json summary = {
+  json summary = {
       {"scene", scene.file},
       {"title", scene.title},
       {"backend", backend_name},
@@ -244,6 +359,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
       {"magnetic_steps_skipped", skipped},  // substeps, with solver.skip_unchanged
       {"outcomes", outcomes},
   };
+  if (c.video) summary["video"] = *c.video;
   write_file_atomically((dir / "summary.json").string(), summary.dump(2) + "\n");
   return 0;
 }

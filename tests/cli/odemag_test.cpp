@@ -516,5 +516,143 @@ TEST_F(Cli, EventsAtTimeZeroShowInSolveAndInTheFirstStateLine) {
   EXPECT_TRUE(json::parse(added.out)["bodies"][0]["present"].get<bool>());
 }
 
+// ---- --video (issue 16 item 3): the frames encoded by the ffmpeg program
+
+// `odemag ARGS` run in dir (relative --out and --video), with PATH=path when given.
+ProgramRun odemag_in(const fs::path& dir, const std::string& args, const std::string& path = "") {
+  return test_support::run_program("cd " + shell_quote(dir.string()) + " && " +
+                                       (path.empty() ? "" : "env PATH=" + shell_quote(path) + " ") +
+                                       shell_quote(kOdemag) + " " + args,
+                                   dir);
+}
+
+// The names in dir that hold ".tmp-" (a temporary left behind).
+std::vector<std::string> temporaries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) names.push_back(e.path().filename().string());
+  return names;
+}
+
+bool no_renderer(const ProgramRun& r) { return r.status == 2 && r.err.find("no renderer") != std::string::npos; }
+
+TEST_F(Cli, VideoWithAnotherExtensionOrWithoutFramesExitsTwoWritingNothing) {
+  const std::string run = "run " + shell_quote(write("scene.json", two_balls()).string()) + " --out out --duration 0.1";
+  const std::pair<std::string, std::string> cases[] = {
+      {" --video clip.avi", "must end in .mp4 or .gif"},
+      {" --video clip", "must end in .mp4 or .gif"},
+      {" --video clip.mp4 --frames no", "--frames no"}};
+  for (const auto& [args, message] : cases) {
+    const ProgramRun r = odemag_in(dir_, run + args);
+    EXPECT_EQ(r.status, 2) << args;  // was 2 as an unknown option, without the reason
+    ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_EQ(r.err.rfind("odemag: --video", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out")) << args;
+    for (const char* name : {"clip.avi", "clip", "clip.mp4"}) EXPECT_FALSE(fs::exists(dir_ / name)) << name;
+  }
+}
+
+TEST_F(Cli, VideoWithoutFfmpegOnPathExitsTwoWritingNothing) {
+  const fs::path scene = write("scene.json", two_balls()), empty = dir_ / "empty_path";
+  fs::create_directories(empty);
+  for (const std::string video : {"clip.mp4", "clip.gif"}) {
+    const ProgramRun r = odemag_in(dir_, "run " + shell_quote(scene.string()) + " --out out --video " + video,
+                                   empty.string());
+    EXPECT_EQ(r.status, 2) << video;
+    ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_EQ(r.err.rfind("odemag: --video " + video + ": ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("apt-get install ffmpeg"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out"));  // decided before the run
+    EXPECT_FALSE(fs::exists(dir_ / video));
+  }
+}
+
+// An ffmpeg that writes half its output and fails: no video, no temporary,
+// no summary.json (the run did not finish), exit 1; the frames stay.
+TEST_F(Cli, VideoThatFfmpegFailsToWriteLeavesNoFile) {
+  const fs::path bin = dir_ / "bin";
+  fs::create_directories(bin);
+  write("bin/ffmpeg", "#!/bin/sh\nprintf '%s\\n' \"$@\" > \"$0.args\"\nfor last; do :; done\n"
+                      "printf half > \"$last\"\nexit 1\n");
+  fs::permissions(bin / "ffmpeg", fs::perms::owner_all);
+  const ProgramRun r = odemag_in(dir_,
+                                 "run " + shell_quote(write("scene.json", two_balls()).string()) +
+                                     " --out out --duration 0.2 --frame-rate 10 --width 64 --height 48 --quiet yes"
+                                     " --video clip.mp4",
+                                 bin.string());
+  if (no_renderer(r)) GTEST_SKIP() << "this build has no renderer: no frames for --video";
+  EXPECT_EQ(r.status, 1) << r.err;
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("ffmpeg failed (exit status 1)"), std::string::npos) << r.err;
+  // Run without a shell, at the frame rate, H.264 yuv420p, to a temporary beside the video.
+  const auto args = lines(read_file(bin / "ffmpeg.args"));
+  const auto rate = std::find(args.begin(), args.end(), "-framerate");
+  ASSERT_TRUE(rate != args.end() && rate + 1 != args.end());
+  EXPECT_EQ(rate[1], "10");
+  EXPECT_NE(std::find(args.begin(), args.end(), "yuv420p"), args.end());
+  EXPECT_EQ(fs::path(args.back()).parent_path(), fs::absolute(dir_).lexically_normal());
+  EXPECT_NE(args.back().find("clip.mp4.tmp-"), std::string::npos) << args.back();
+  EXPECT_FALSE(fs::exists(dir_ / "clip.mp4"));
+  EXPECT_EQ(temporaries(dir_), std::vector<std::string>{});
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "summary.json"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "frame_00002.png"));
+}
+
+TEST_F(Cli, VideoIsAnMp4OrAGifEncodedByFfmpeg) {
+  if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "ffmpeg is not installed here (apt-get install ffmpeg): the encoding is not tested";
+  const fs::path scene = write("scene.json", two_balls());
+  // An odd frame size (the MP4 is padded to even dimensions: libx264 refuses
+  // odd ones in yuv420p); the GIF in --out, which the run creates.
+  for (const std::string video : {"clip.mp4", "out/clip.gif"}) {
+    const ProgramRun r = odemag_in(dir_, "run " + shell_quote(scene.string()) +
+                                             " --out out --duration 0.2 --frame-rate 10 --width 65 --height 49"
+                                             " --quiet yes --video " + video);
+    if (no_renderer(r)) GTEST_SKIP() << "this build has no renderer: no frames for --video";
+    ASSERT_EQ(r.status, 0) << video << ": " << r.err;
+    const std::string bytes = read_file(dir_ / video);
+    ASSERT_GE(bytes.size(), 8u) << video;
+    if (video == "clip.mp4")
+      EXPECT_EQ(bytes.substr(4, 4), "ftyp");  // ISO BMFF: the first box is ftyp
+    else
+      EXPECT_EQ(bytes.substr(0, 6), "GIF89a");
+    EXPECT_EQ(json::parse(read_file(dir_ / "out" / "summary.json"))["video"], video);
+    for (const char* frame : {"frame_00000.png", "frame_00001.png", "frame_00002.png"})
+      EXPECT_TRUE(fs::exists(dir_ / "out" / frame)) << frame;  // the PNG frames stay
+    EXPECT_EQ(temporaries(dir_), std::vector<std::string>{});
+    EXPECT_EQ(temporaries(dir_ / "out"), std::vector<std::string>{});
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "clip.mp4"));  // relative to the current directory, not to --out
+}
+
+TEST_F(Cli, StateEveryStepWritesALinePerRigidStep) {
+  const fs::path scene = write("scene.json", two_balls());
+  const fs::path out = dir_ / "out";
+  const std::string common = "run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) +
+                             " --duration 0.1 --time-step 0.01 --frame-rate 20 --frames no --quiet yes";
+  ProgramRun r = odemag(common);
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto state = lines(read_file(out / "state.jsonl"));
+  ASSERT_EQ(state.size(), 3u);  // frames at 0, 0.05 and 0.1 s
+  EXPECT_EQ(json::parse(state[1])["step"], 5);
+  r = odemag(common + " --state-every-step yes");
+  ASSERT_EQ(r.status, 0) << r.err;
+  state = lines(read_file(out / "state.jsonl"));
+  ASSERT_EQ(state.size(), 11u);  // t = 0 and each of the 10 steps
+  int frames = 0;
+  for (size_t k = 0; k < state.size(); ++k) {
+    const json line = json::parse(state[k]);
+    EXPECT_EQ(line["step"], k);
+    EXPECT_NEAR(line["time"].get<double>(), 0.01 * static_cast<double>(k), 1e-9);
+    EXPECT_EQ(line["bodies"].size(), 2u);
+    if (line.contains("frame")) {
+      EXPECT_EQ(line["frame"], frames++);
+    }
+  }
+  EXPECT_EQ(frames, 3);
+  EXPECT_EQ(odemag(common + " --state-every-step maybe").status, 2);
+}
+
 }  // namespace
 }  // namespace odemag
