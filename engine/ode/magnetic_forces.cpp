@@ -84,6 +84,69 @@ int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& mat
   return index;
 }
 
+int MagneticForces::attach(dBodyID body, const Shape& shape, const std::map<std::string, Material>& materials,
+                           const std::string& material, double cell_size, const std::string& name) {
+  const auto found = materials.find(material);
+  if (found == materials.end()) {
+    std::string known;
+    for (const auto& [key, value] : materials) known += (known.empty() ? "\"" : ", \"") + key + "\"";
+    throw std::invalid_argument("MagneticForces::attach: no material \"" + material + "\" (known: " +
+                                (known.empty() ? "none" : known) + ")");
+  }
+  return attach(body, shape, found->second, cell_size, name);
+}
+
+namespace {
+
+// Cells and soft moments of each body of the model.
+void count_cells(const MagneticModel& model, std::vector<int>& cells, std::vector<int>& moments) {
+  cells.assign(static_cast<size_t>(model.body_count()), 0);
+  moments.assign(static_cast<size_t>(model.body_count()), 0);
+  for (int b = 0; b < model.body_count(); ++b) {
+    const MagneticBody& body = model.body(b);
+    cells[b] = body.cell_count();
+    if (body.kind == CellKind::soft) moments[b] = body.cell_count() * body.soft.n;
+  }
+}
+
+}  // namespace
+
+SavedMagneticState MagneticForces::save_state() const {
+  SavedMagneticState saved;
+  saved.state = state_;
+  saved.report = report_;
+  count_cells(model_, saved.body_cells, saved.body_moments);
+  return saved;
+}
+
+void MagneticForces::restore_state(const SavedMagneticState& saved) {
+  const std::string where = "MagneticForces::restore_state: ";
+  std::vector<int> cells, moments;
+  count_cells(model_, cells, moments);
+  if (saved.body_cells.size() != cells.size() || saved.body_moments.size() != moments.size())
+    throw std::invalid_argument(where + "the state was saved from " + std::to_string(saved.body_cells.size()) +
+                                " bodies, these magnetics have " + std::to_string(cells.size()));
+  for (size_t b = 0; b < cells.size(); ++b)
+    if (saved.body_cells[b] != cells[b] || saved.body_moments[b] != moments[b])
+      throw std::invalid_argument(where + "body " + std::to_string(b) + " \"" +
+                                  model_.body(static_cast<int>(b)).name + "\" has " + std::to_string(cells[b]) +
+                                  " cells and " + std::to_string(moments[b]) + " moments, the saved state " +
+                                  std::to_string(saved.body_cells[b]) + " and " + std::to_string(saved.body_moments[b]));
+  // The state's own arrays (a saved state edited by hand).
+  const MagneticState& s = saved.state;
+  const size_t nb = cells.size(), nc = static_cast<size_t>(model_.cell_count()),
+               nm = static_cast<size_t>(model_.moment_count());
+  const bool sized = s.pose.size() == nb && s.active.size() == nb && s.magnetization_scale.size() == nb &&
+                     s.force.size() == nb && s.torque.size() == nb && s.cell_position.size() == nc &&
+                     s.magnetization.size() == nc && s.applied_field.size() == nc && s.llg_history.size() == nc &&
+                     s.noise_counter.size() == nc && s.moments.size() == nm && s.moment_hc_prev.size() == nm;
+  if (!sized)
+    throw std::invalid_argument(where + "the saved state's arrays do not match its " + std::to_string(nb) +
+                                " bodies, " + std::to_string(nc) + " cells and " + std::to_string(nm) + " moments");
+  state_ = s;
+  report_ = saved.report;
+}
+
 void MagneticForces::set_external_field(const Vec3& H) {
   if (!is_finite(H))
     throw std::invalid_argument("MagneticForces::set_external_field: the field " + format(H) + " is not finite");

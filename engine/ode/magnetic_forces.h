@@ -8,6 +8,9 @@
 //   magnetics.attach(ball_body, odemag::Sphere{0.006}, iron);
 //   loop { magnetics.apply(); dSpaceCollide(...); dWorldQuickStep(...); dJointGroupEmpty(...); }
 //
+// or that loop in the substeps of `odemag run`: MagneticStepper
+// (engine/ode/magnetic_stepper.h, docs/embedding.md "Substeps").
+//
 // The moments persist from step to step (warm start), which is what makes
 // remanence possible.
 #pragma once
@@ -15,6 +18,7 @@
 #include <ode/ode.h>
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +30,15 @@
 #include "magnetics/state.h"
 
 namespace odemag {
+
+// A copy of the magnetic state (MagneticForces::save_state), and what it
+// belongs to: the cell and moment counts of every body it was saved from.
+struct SavedMagneticState {
+  MagneticState state;
+  RelaxReport report;                // last_report() when saved
+  std::vector<int> body_cells;       // per body: cells
+  std::vector<int> body_moments;     // per body: soft moments
+};
 
 class MagneticForces : public ForceAccumulator {
  public:
@@ -50,6 +63,13 @@ class MagneticForces : public ForceAccumulator {
   // cell is made.
   int attach(dBodyID body, const Shape& shape, const Material& material, double cell_size = 0.0,
              const std::string& name = "");
+  // The same with the material named `material` of a set of named materials,
+  // a scene file's (SceneDescription::materials, engine/scene/scene.h;
+  // docs/embedding.md "Materials from a scene file"). Throws
+  // std::invalid_argument naming the material and the known ones when there
+  // is none of that name.
+  int attach(dBodyID body, const Shape& shape, const std::map<std::string, Material>& materials,
+             const std::string& material, double cell_size = 0.0, const std::string& name = "");
 
   // Reads the poses of the ODE bodies, relaxes the magnetization from the
   // previous step's moments, computes forces and torques and adds them to the
@@ -114,6 +134,15 @@ class MagneticForces : public ForceAccumulator {
   Vec3 moment(int index) const;
   Vec3 force(int index) const { return state_.force[body_index(index, "force")]; }                  // N, world
   Vec3 torque(int index) const { return state_.torque[body_index(index, "torque")]; }                // N m, about the CoM
+
+  // Saving and restoring the magnetic state (docs/embedding.md "Saving and
+  // restoring"): every cell's moments and magnetization, the warm-start and
+  // skip data, poses, forces, active flags, magnetization scales, the
+  // external field, the noise counters and the last relaxation report.
+  // restore_state() throws std::invalid_argument, changing nothing, when the
+  // state was saved from magnetics with other bodies or cells.
+  SavedMagneticState save_state() const;
+  void restore_state(const SavedMagneticState& saved);
 
   const MagneticModel& model() const { return model_; }
   const MagneticState& state() const { return state_; }

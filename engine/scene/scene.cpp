@@ -23,6 +23,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "magnetics/constants.h"
+
 namespace odemag {
 
 SceneError::SceneError(std::string file, std::string key, std::string message)
@@ -688,6 +690,78 @@ BodyDescription read_body(const SceneReader& r, const json& v, const std::string
   return body;
 }
 
+// ---- joints ------------------------------------------------------------------------
+
+struct JointTarget {
+  JointDescription joint;
+  const SceneDescription& scene;
+  const BodyIndex& index;
+};
+
+const KeyTable<JointTarget> kJointKeys = {
+    {.name = "type",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, JointTarget& t) {
+       const std::string type = r.choice(x, p, {"hinge", "ball", "slider", "fixed"});
+       t.joint.type = type == "hinge"    ? JointDescription::Type::hinge
+                      : type == "ball"   ? JointDescription::Type::ball
+                      : type == "slider" ? JointDescription::Type::slider
+                                         : JointDescription::Type::fixed;
+     },
+     .required = true, .doc = {"string", "", "**required**"}},
+    {.name = "bodies",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, JointTarget& t) {
+       if (!x.is_array() || x.empty() || x.size() > 2)
+         r.fail(p, "must be an array of one body name (jointed to the world) or two");
+       size_t fixed = 0;
+       for (size_t i = 0; i < x.size(); ++i) {
+         const std::string name = r.string(x[i], element(p, i));
+         const auto it = t.index.find(name);
+         if (it == t.index.end()) r.fail(element(p, i), "no body named " + as_literal(name));
+         if (i == 1 && name == t.joint.bodies[0]) r.fail(element(p, i), "a joint needs two different bodies");
+         fixed += t.scene.bodies[it->second].fixed ? 1 : 0;
+         t.joint.bodies.push_back(name);
+       }
+       if (fixed == x.size())
+         r.fail(p, x.size() == 1 ? "the body is fixed: a joint to the world would do nothing"
+                                 : "both bodies are fixed: the joint would do nothing");
+     },
+     .required = true, .doc = {"array", "", "**required**"}},
+    {.name = "anchor", .check = Check::vec3, .slot = SLOT(joint.anchor), .bound = kLength,
+     .doc = {"vector", "m", "hinge, ball: required"}},
+    {.name = "axis", .check = Check::non_zero_vec3, .slot = SLOT(joint.axis),
+     .doc = {"vector", "", "`[0, 0, 1]`"}},
+    {.name = "limits",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, JointTarget& t) {
+       if (!x.is_array() || x.size() != 2) r.fail(p, "must be an array [low, high]");
+       const bool hinge = t.joint.type == JointDescription::Type::hinge;
+       const double lo = hinge ? r.in_range(x[0], element(p, 0), -kPi, kPi)
+                               : r.bounded(r.number(x[0], element(p, 0)), element(p, 0), kLength);
+       const double hi = hinge ? r.in_range(x[1], element(p, 1), -kPi, kPi)
+                               : r.bounded(r.number(x[1], element(p, 1)), element(p, 1), kLength);
+       if (!(lo <= hi)) r.fail(p, "low must not exceed high, got [" + format_number(lo) + ", " + format_number(hi) + "]");
+       t.joint.limits = std::array<double, 2>{lo, hi};
+     },
+     .doc = {"[low, high]", "rad or m", "no limits"}},
+};
+
+JointDescription read_joint(const SceneReader& r, const json& v, const std::string& path,
+                            const SceneDescription& scene, const BodyIndex& index) {
+  JointTarget t{{}, scene, index};
+  read_object(r, v, path, kJointKeys, t);
+  // Which keys a joint of each type takes.
+  using Type = JointDescription::Type;
+  const Type type = t.joint.type;
+  const bool anchored = type == Type::hinge || type == Type::ball;
+  const bool has_axis = type == Type::hinge || type == Type::slider;
+  const char* name = type == Type::hinge ? "hinge" : type == Type::ball ? "ball" : type == Type::slider ? "slider" : "fixed";
+  if (anchored && !v.contains("anchor")) r.fail(member(path, "anchor"), std::string("a ") + name + " joint needs an anchor");
+  if (!anchored && v.contains("anchor")) r.fail(member(path, "anchor"), std::string("a ") + name + " joint has no anchor");
+  if (!has_axis && v.contains("axis")) r.fail(member(path, "axis"), std::string("a ") + name + " joint has no axis");
+  if (!has_axis && v.contains("limits"))
+    r.fail(member(path, "limits"), std::string("a ") + name + " joint has no limits (hinge and slider have)");
+  return t.joint;
+}
+
 // ---- settings ----------------------------------------------------------------------
 
 const KeyTable<SolverSettings> kSolverKeys = {
@@ -962,21 +1036,102 @@ TimelineEvent read_event(const SceneReader& r, const json& v, const std::string&
   return t.e;
 }
 
-const KeyTable<OutcomeDescription> kCountAboveKeys = {
-    {.name = "prefix", .check = Check::string, .slot = SLOT(prefix), .required = true},
-    {.name = "height", .check = Check::number, .slot = SLOT(height), .bound = kLength, .required = true},
+struct OutcomeTarget {
+  OutcomeDescription outcome;
+  const SceneDescription& scene;
+  const BodyIndex& index;
 };
 
-const KeyTable<OutcomeDescription> kOutcomeKeys = {
-    {.name = "name", .check = Check::non_empty_string, .slot = SLOT(name), .required = true,
-     .doc = {"string", "", "**required**"}},
-    {.name = "count_above",
-     .read = [](const SceneReader& r, const json& x, const std::string& p, OutcomeDescription& o) {
-       read_object(r, x, p, kCountAboveKeys, o);
+// The body named by x, stored in the outcome's bodies.
+void read_outcome_body(const SceneReader& r, const json& x, const std::string& p, OutcomeTarget& t) {
+  const std::string name = r.string(x, p);
+  if (!t.index.count(name)) r.fail(p, "no body named " + as_literal(name));
+  t.outcome.bodies.push_back(name);
+}
+
+const KeyTable<OutcomeTarget> kCountAboveKeys = {
+    {.name = "prefix",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, OutcomeTarget& t) {
+       t.outcome.prefix = r.string(x, p);
+       // A prefix that names no body would count nothing, silently.
+       for (const BodyDescription& body : t.scene.bodies)
+         if (body.name.rfind(t.outcome.prefix, 0) == 0) return;
+       r.fail(p, "no body's name starts with " + as_literal(t.outcome.prefix));
      },
-     .required = true, .doc = {"object", "", "**required**"}},
-    {.name = "time", .check = Check::number, .slot = SLOT(time), .doc = {"number", "", "`-1`"}},
+     .required = true},
+    {.name = "height", .check = Check::number, .slot = SLOT(outcome.height), .bound = kLength, .required = true},
 };
+const KeyTable<OutcomeTarget> kOutcomeBodyKeys = {
+    {.name = "body", .read = read_outcome_body, .required = true},
+};
+const KeyTable<OutcomeTarget> kOutcomeVectorKeys = {
+    {.name = "body", .read = read_outcome_body, .required = true},
+    {.name = "component",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, OutcomeTarget& t) {
+       const std::string c = r.choice(x, p, {"x", "y", "z", "magnitude"});
+       t.outcome.component = c == "magnitude" ? -1 : c[0] - 'x';
+     }},
+};
+const KeyTable<OutcomeTarget> kDistanceKeys = {
+    {.name = "bodies",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, OutcomeTarget& t) {
+       if (!x.is_array() || x.size() != 2) r.fail(p, "must be an array of two body names");
+       for (size_t i = 0; i < 2; ++i) read_outcome_body(r, x[i], element(p, i), t);
+     },
+     .required = true},
+};
+
+// The quantity keys of an outcome, each with its object's keys.
+struct OutcomeQuantity {
+  const char* key;
+  OutcomeDescription::Quantity quantity;
+  const KeyTable<OutcomeTarget>* keys;
+};
+const std::vector<OutcomeQuantity> kOutcomeQuantities = {
+    {"count_above", OutcomeDescription::Quantity::count_above, &kCountAboveKeys},
+    {"distance", OutcomeDescription::Quantity::distance, &kDistanceKeys},
+    {"height", OutcomeDescription::Quantity::height, &kOutcomeBodyKeys},
+    {"speed", OutcomeDescription::Quantity::speed, &kOutcomeBodyKeys},
+    {"contact_count", OutcomeDescription::Quantity::contact_count, &kOutcomeBodyKeys},
+    {"force", OutcomeDescription::Quantity::force, &kOutcomeVectorKeys},
+    {"moment", OutcomeDescription::Quantity::moment, &kOutcomeVectorKeys},
+};
+
+template <int Q>
+void read_quantity(const SceneReader& r, const json& x, const std::string& p, OutcomeTarget& t) {
+  t.outcome.quantity = kOutcomeQuantities[Q].quantity;
+  read_object(r, x, p, *kOutcomeQuantities[Q].keys, t);
+}
+
+const KeyTable<OutcomeTarget> kOutcomeKeys = {
+    {.name = "name", .check = Check::non_empty_string, .slot = SLOT(outcome.name), .required = true,
+     .doc = {"string", "", "**required**"}},
+    {.name = "count_above", .read = read_quantity<0>, .doc = {"object", "", "one quantity is required"}},
+    {.name = "distance", .read = read_quantity<1>, .doc = {"object", "", ""}},
+    {.name = "height", .read = read_quantity<2>, .doc = {"object", "", ""}},
+    {.name = "speed", .read = read_quantity<3>, .doc = {"object", "", ""}},
+    {.name = "contact_count", .read = read_quantity<4>, .doc = {"object", "", ""}},
+    {.name = "force", .read = read_quantity<5>, .doc = {"object", "", ""}},
+    {.name = "moment", .read = read_quantity<6>, .doc = {"object", "", ""}},
+    {.name = "time", .check = Check::number, .slot = SLOT(outcome.time), .doc = {"number", "s", "`-1`"}},
+    {.name = "statistic", .check = Check::choice, .slot = SLOT(outcome.statistic), .words = {"max", "min"},
+     .doc = {"string", "", "`\"\"`"}},
+};
+
+OutcomeDescription read_outcome(const SceneReader& r, const json& v, const std::string& path,
+                                const SceneDescription& scene, const BodyIndex& index) {
+  r.require_object(v, path);
+  size_t quantities = 0;
+  for (const OutcomeQuantity& q : kOutcomeQuantities) quantities += v.contains(q.key) ? 1 : 0;
+  if (quantities != 1)
+    r.fail(path, "must have exactly one of the keys count_above, distance, height, speed, contact_count, force, "
+                 "moment (it has " + std::to_string(quantities) + ")");
+  OutcomeTarget t{{}, scene, index};
+  read_object(r, v, path, kOutcomeKeys, t);
+  if (!t.outcome.statistic.empty() && v.contains("time"))
+    r.fail(member(path, "time"), "an outcome with a statistic (max, min over the run) has no time");
+  return t.outcome;
+}
 
 // ---- the whole file --------------------------------------------------------------
 
@@ -1022,6 +1177,13 @@ const KeyTable<SceneTarget> kSceneKeys = {
        }
      },
      .required = true, .doc = {"array", "", "**required**"}},
+    {.name = "joints",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
+       if (!x.is_array()) r.fail(p, "must be an array of joints");
+       for (size_t i = 0; i < x.size(); ++i)
+         t.scene.joints.push_back(read_joint(r, x[i], element(p, i), t.scene, t.index));
+     },
+     .doc = {"array", "", "`[]`"}},
     {.name = "solver",
      .read = [](const SceneReader& r, const json& x, const std::string& p, SceneTarget& t) {
        read_object(r, x, p, kSolverKeys, t.scene.solver);
@@ -1054,14 +1216,7 @@ const KeyTable<SceneTarget> kSceneKeys = {
        if (!x.is_array()) r.fail(p, "must be an array of outcomes");
        std::set<std::string> names;
        for (size_t i = 0; i < x.size(); ++i) {
-         OutcomeDescription o;
-         read_object(r, x[i], element(p, i), kOutcomeKeys, o);
-         // A prefix that names no body would count nothing, silently.
-         bool names_a_body = false;
-         for (const BodyDescription& body : t.scene.bodies) names_a_body = names_a_body || body.name.rfind(o.prefix, 0) == 0;
-         if (!names_a_body)
-           r.fail(member(member(element(p, i), "count_above"), "prefix"),
-                  "no body's name starts with " + as_literal(o.prefix));
+         const OutcomeDescription o = read_outcome(r, x[i], element(p, i), t.scene, t.index);
          t.scene.outcomes.push_back(o);
          if (!names.insert(o.name).second)
            r.fail(member(element(p, i), "name"), "another outcome is already named " + as_literal(o.name));
@@ -1091,6 +1246,18 @@ struct FreshTarget<BodyTarget> {
   SceneDescription scene;
   BodyIndex index;
   BodyTarget target{{}, scene, index};
+};
+template <>
+struct FreshTarget<OutcomeTarget> {
+  SceneDescription scene;
+  BodyIndex index;
+  OutcomeTarget target{{}, scene, index};
+};
+template <>
+struct FreshTarget<JointTarget> {
+  SceneDescription scene;
+  BodyIndex index;
+  JointTarget target{{}, scene, index};
 };
 template <>
 struct FreshTarget<EventTarget> {
@@ -1138,6 +1305,7 @@ std::vector<SceneKeyDoc> scene_key_docs() {
   add_key_docs(docs, "bodies[]", kBodyKeys);
   add_key_docs(docs, "bodies[].shape", kShapeKeys);
   add_key_docs(docs, "bodies[].shape.cylinder", kCylinderKeys);
+  add_key_docs(docs, "joints[]", kJointKeys);
   add_key_docs(docs, "solver", kSolverKeys);
   add_key_docs(docs, "simulation", kSimulationKeys);
   add_key_docs(docs, "simulation.contact", kContactKeys);
@@ -1147,7 +1315,7 @@ std::vector<SceneKeyDoc> scene_key_docs() {
   add_key_docs(docs, "camera", kCameraKeys);
   add_key_docs(docs, "render", kRenderKeys);
   add_key_docs(docs, "outcomes[]", kOutcomeKeys);
-  add_key_docs(docs, "outcomes[].count_above", kCountAboveKeys);
+  for (const OutcomeQuantity& q : kOutcomeQuantities) add_key_docs(docs, std::string("outcomes[].") + q.key, *q.keys);
   return docs;
 }
 

@@ -49,6 +49,19 @@ struct BodyDescription {
   std::optional<std::array<double, 3>> color;  // RGB 0..1, overrides the material colour
 };
 
+// An ODE joint between two bodies, or between one body and the world
+// (docs/scene-format.md "joints"). Anchor and axis are in the world frame
+// at the bodies' initial poses.
+struct JointDescription {
+  enum class Type { hinge, ball, slider, fixed };
+  Type type = Type::hinge;
+  std::vector<std::string> bodies;  // one (jointed to the world) or two
+  Vec3 anchor;                      // m: hinge and ball
+  Vec3 axis{0.0, 0.0, 1.0};         // hinge and slider
+  // Stops: hinge angle in rad (-pi..pi) from the initial pose, slider travel in m.
+  std::optional<std::array<double, 2>> limits;
+};
+
 struct SolverSettings {
   RelaxOptions relax;          // scheme, tolerance, max_iterations, mutual_induction, ...
   std::string backend = "auto";  // "cpu", "cuda", "auto"
@@ -139,11 +152,25 @@ struct RenderSettings {
 // A number the scene reports in summary.json: how many bodies whose names start
 // with `prefix` have their centre above `height` (m) at time `time`
 // (negative: the end of the run).
+// A number a run reports in its summary (docs/scene-format.md "outcomes").
 struct OutcomeDescription {
+  enum class Quantity {
+    count_above,    // bodies named prefix* with their centre above height
+    distance,       // between the centres of bodies[0] and bodies[1], m
+    height,         // z of the body's centre, m
+    speed,          // |v| of the body, m/s
+    contact_count,  // contacts of the body in the last substep
+    force,          // magnetic force on the body, N (component or magnitude)
+    moment,         // the body's magnetic moment, A m^2 (component or magnitude)
+  };
   std::string name;
-  std::string prefix;
-  double height = 0.0;
-  double time = -1.0;
+  Quantity quantity = Quantity::count_above;
+  std::string prefix;               // count_above
+  double height = 0.0;              // count_above: m
+  std::vector<std::string> bodies;  // the body; two for distance
+  int component = -1;               // force, moment: 0, 1, 2 for x, y, z; -1: the magnitude
+  double time = -1.0;               // s; when to evaluate; negative: at the end of the run
+  std::string statistic;            // "max" or "min" over every step of the run; "": at `time`
 };
 
 struct SceneDescription {
@@ -156,6 +183,7 @@ struct SceneDescription {
   std::map<std::string, Material> materials;
   std::map<std::string, std::array<double, 3>> material_colors;  // optional "color" per material
   std::vector<BodyDescription> bodies;
+  std::vector<JointDescription> joints;
   SolverSettings solver;
   SimulationSettings simulation;
   std::vector<TimelineEvent> timeline;

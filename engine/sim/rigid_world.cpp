@@ -89,6 +89,44 @@ RigidWorld::RigidWorld(const SceneDescription& scene) : contact_(scene.simulatio
     bodies_.push_back(b);
     if (!d.present) set_enabled(body_count() - 1, false);
   }
+  for (const JointDescription& j : scene.joints) add_joint(scene, j);
+}
+
+void RigidWorld::add_joint(const SceneDescription& scene, const JointDescription& j) {
+  dBodyID a = bodies_[scene.find_body(j.bodies[0])].body;
+  dBodyID b = j.bodies.size() > 1 ? bodies_[scene.find_body(j.bodies[1])].body : nullptr;
+  const Vec3 &p = j.anchor, &n = j.axis;
+  dJointID joint = nullptr;
+  switch (j.type) {
+    case JointDescription::Type::hinge:
+      joint = dJointCreateHinge(world_, nullptr);
+      dJointAttach(joint, a, b);
+      dJointSetHingeAnchor(joint, p.x, p.y, p.z);
+      dJointSetHingeAxis(joint, n.x, n.y, n.z);
+      break;
+    case JointDescription::Type::ball:
+      joint = dJointCreateBall(world_, nullptr);
+      dJointAttach(joint, a, b);
+      dJointSetBallAnchor(joint, p.x, p.y, p.z);
+      break;
+    case JointDescription::Type::slider:
+      joint = dJointCreateSlider(world_, nullptr);
+      dJointAttach(joint, a, b);
+      dJointSetSliderAxis(joint, n.x, n.y, n.z);
+      break;
+    case JointDescription::Type::fixed:
+      joint = dJointCreateFixed(world_, nullptr);
+      dJointAttach(joint, a, b);
+      dJointSetFixed(joint);
+      break;
+  }
+  if (j.limits) {
+    // The low stop first: ODE ignores a low stop above the current high one.
+    const auto set = j.type == JointDescription::Type::hinge ? dJointSetHingeParam : dJointSetSliderParam;
+    set(joint, dParamLoStop, (*j.limits)[0]);
+    set(joint, dParamHiStop, (*j.limits)[1]);
+  }
+  has_joints_ = true;
 }
 
 RigidWorld::~RigidWorld() {
@@ -148,7 +186,7 @@ void RigidWorld::update_forces(double time, double dt) {
 
 void RigidWorld::integrate(double h) {
   for (ForceAccumulator* a : accumulators_) a->add_forces();
-  for (Body& b : bodies_) b.in_contact = false;
+  for (Body& b : bodies_) b.in_contact = false, b.contacts = 0;
   dSpaceCollide(space_, this, &RigidWorld::near_callback);
   if (exact_solver_) {
     dWorldStep(world_, h);
@@ -164,11 +202,17 @@ void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
   const bool a_moves = ba && !dBodyIsKinematic(ba);
   const bool b_moves = bb && !dBodyIsKinematic(bb);
   if (!a_moves && !b_moves) return;  // nothing to resolve between immovable things
+  // Jointed bodies do not collide with each other (a needle on its pivot).
+  if (self->has_joints_ && ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
   dContact contact[kMaxContacts];
   const int n = dCollide(a, b, kMaxContacts, &contact[0].geom, sizeof(dContact));
   if (n > 0) {
     for (dBodyID body : {ba, bb})
-      if (body) self->bodies_[self->index_of(body)].in_contact = true;
+      if (body) {
+        Body& touched = self->bodies_[self->index_of(body)];
+        touched.in_contact = true;
+        touched.contacts += n;
+      }
   }
   const double skins = self->skin_of(a) + self->skin_of(b);
   for (int i = 0; i < n; ++i) {

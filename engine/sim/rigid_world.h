@@ -53,6 +53,8 @@ class RigidWorld {
 
   // Whether the body touched something in the last integrate().
   bool in_contact(int i) const { return bodies_[i].in_contact; }
+  // Its contact points in the last integrate() (ODE's dCollide gives up to 8 per pair).
+  int contact_count(int i) const { return bodies_[i].contacts; }
 
   BodyPose pose(int i) const;
   Vec3 velocity(int i) const;
@@ -66,8 +68,11 @@ class RigidWorld {
     bool enabled = true;
     double mass = 0.0;
     bool in_contact = false;
+    int contacts = 0;
     double skin = 0.0;  // collision geometry enlarged by this much, m
   };
+  // An ODE joint of the scene (docs/scene-format.md "joints"), in the world frame.
+  void add_joint(const SceneDescription& scene, const JointDescription& joint);
   int index_of(dBodyID body) const;
   static void near_callback(void* data, dGeomID a, dGeomID b);
   double skin_of(dGeomID geom) const;
@@ -76,6 +81,7 @@ class RigidWorld {
   dSpaceID space_ = nullptr;
   dJointGroupID contacts_ = nullptr;
   dGeomID ground_ = nullptr;
+  bool has_joints_ = false;
   std::vector<Body> bodies_;
   std::vector<ForceAccumulator*> accumulators_;
   ContactSettings contact_;

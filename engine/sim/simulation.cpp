@@ -4,12 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
-#include <variant>
 
 #include <Eigen/Geometry>
 
 #include "engine/sim/magnetic_system.h"
-#include "magnetics/constants.h"
 
 namespace odemag {
 
@@ -56,7 +54,7 @@ BodyPose keyframe_pose(const std::vector<Keyframe>& keys, double t) {
 }
 
 Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBackend> backend)
-    : scene_(scene) {
+    : scene_(scene), outcomes_(scene_) {
   world_ = std::make_unique<RigidWorld>(scene_);
   // The magnetic model of the scene, built as for solve and field
   // (build_magnetic_system), then tied to the ODE bodies.
@@ -66,21 +64,14 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
       backend ? std::move(backend) : make_cpu_backend(scene_.solver.threads));
   for (size_t b = 0; b < scene_.bodies.size(); ++b) magnetics_->bind(static_cast<int>(b), world_->body(static_cast<int>(b)));
   world_->add_accumulator(magnetics_.get());
+  // The substep rule's view of each body: shape, material, ODE inertia.
+  substep_rule_ = SubstepRule({scene_.simulation.max_substeps, scene_.simulation.stiffness_limit});
   for (size_t b = 0; b < scene_.bodies.size(); ++b) {
-    const Vec3 half = shape_half_extents(scene_.bodies[b].shape);
-    body_size_.push_back(std::min({half.x, half.y, half.z}));
-    // A sphere's surface does not move when it turns about its centre.
-    body_reach_.push_back(std::holds_alternative<Sphere>(scene_.bodies[b].shape) ? 0.0
-                                                                                 : norm(half));
-    dMass mass;  // body-frame inertia: diagonal for the centred, axis-aligned shapes
+    dMass mass;
     dBodyGetMass(world_->body(static_cast<int>(b)), &mass);
-    body_inertia_.push_back(std::min({mass.I[0], mass.I[5], mass.I[10]}));
-    // A uniform field turns every magnetic body but an isotropic one-cell
-    // soft body (a plain iron ball), whose moment simply follows the field.
-    const MagneticBody& mb = magnetics_->model().body(static_cast<int>(b));
-    body_turns_in_field_.push_back(
-        !mb.inert() && !(mb.kind == CellKind::soft && mb.cell_count() == 1 && mb.soft.H_K == 0.0));
+    substep_rule_.add_body(substep_body(magnetics_->model().body(static_cast<int>(b)), mass));
   }
+  substep_motion_.resize(scene_.bodies.size());
   event_state_.assign(scene_.timeline.size(), kPending);
   ramp_start_scale_.assign(scene_.timeline.size(), 1.0);
   ramp_start_field_.assign(scene_.timeline.size(), Vec3{});
@@ -144,68 +135,26 @@ void Simulation::apply_timeline(double dt) {
   }
 }
 
-int Simulation::substeps_needed(double dt) const {
-  double shortest = dt;  // longest admissible substep
+int Simulation::substeps_needed(double dt) {
   for (int b = 0; b < world_->body_count(); ++b) {
-    if (world_->kinematic(b) || !world_->enabled(b)) continue;
-    const double f = norm(magnetics_->force(b)), m = world_->mass(b), size = body_size_[b];
-    const double reach = body_reach_[b], inertia = body_inertia_[b];
-    // Rotational stiffness: |tau| for the torque of the other bodies (it
-    // turns a body about an orientation of equilibrium), and mu0 |m| |H_E|
-    // for the uniform field, whose torque vanishes at equilibrium while its
-    // stiffness does not (docs/hard-cases.md "Substeps").
-    double k_rot = norm(magnetics_->torque(b));
-    if (body_turns_in_field_[b])
-      k_rot += kMu0 * norm(magnetics_->moment(b)) * norm(magnetics_->external_field());
-    // Collision: the travel v h + a h^2 / 2 in one substep of the body's
-    // farthest point, at the current velocity (translation plus rotation
-    // times the bounding radius) and the full acceleration (gravity, magnetic
-    // force, and the angular acceleration times the bounding radius), at most
-    // L: a tenth of the body's size, three tenths for a body that was in
-    // contact (which most likely still holds it; it may have lifted off by a
-    // hair, so its acceleration still counts). Solved for h.
-    const double v = norm(world_->velocity(b)) + norm(world_->angular_velocity(b)) * reach;
-    const double a = f / m + norm(scene_.gravity) +
-                     (inertia > 0.0 ? norm(magnetics_->torque(b)) / inertia * reach : 0.0);
-    const double L = (world_->in_contact(b) ? 0.3 : 0.1) * size;
-    shortest = std::min(shortest, 2.0 * L / (v + std::sqrt(v * v + 2.0 * a * L)));
-    // Time scale of the magnetic force: it varies over distances of the
-    // body's size, so it oscillates a body about an equilibrium at
-    // omega^2 ~ |F| / (m size); and the torque about an orientation at
-    // omega^2 ~ k_rot / I. The explicit update needs omega h <= limit.
-    if (f > 0.0) shortest = std::min(shortest, scene_.simulation.stiffness_limit / std::sqrt(f / (m * size)));
-    if (k_rot > 0.0 && inertia > 0.0)
-      shortest = std::min(shortest, scene_.simulation.stiffness_limit / std::sqrt(k_rot / inertia));
+    SubstepMotion& m = substep_motion_[b];
+    m.free = !world_->kinematic(b) && world_->enabled(b);
+    if (!m.free) continue;
+    m.mass = world_->mass(b);
+    m.velocity = world_->velocity(b);
+    m.angular_velocity = world_->angular_velocity(b);
+    m.force = magnetics_->force(b);
+    m.torque = magnetics_->torque(b);
+    if (substep_rule_.body(b).turns_in_field) m.moment = magnetics_->moment(b);
+    m.in_contact = world_->in_contact(b);
   }
-  const double k = std::ceil(dt / shortest * (1.0 - 1e-12));
-  return std::isfinite(k) ? std::max(1, static_cast<int>(std::min(k, 1e9))) : 1000000000;
+  return substep_rule_.needed(dt, substep_motion_, norm(scene_.gravity), norm(magnetics_->external_field()));
 }
 
 void Simulation::update_substeps(double dt, bool step_start, StepRecord& record) {
-  // The count rises at once when needed but falls only at the start of a
-  // step, after a lower count has sufficed for a while, to the largest count
-  // needed meanwhile. A count that follows the phase of an oscillation (|v|,
-  // |F| and |tau| all vary along it) makes the integration non-symplectic
-  // and pumps energy into the oscillation (docs/hard-cases.md: a magnet
-  // swinging in a uniform field of 1e5 A/m gained 21 times its swing energy
-  // in 2 s). The hold is one period of the slowest oscillation whose
-  // stiffness alone asks for more than one substep, 2 pi dt / stiffness_limit.
-  const double hold = 2.0 * kPi * dt / std::max(scene_.simulation.stiffness_limit, 1e-9);
   const int wanted = substeps_needed(dt);
   record.substeps_wanted = std::max(record.substeps_wanted, wanted);
-  const int needed = std::min(wanted, std::max(1, scene_.simulation.max_substeps));
-  if (needed >= substeps_) {
-    substeps_ = needed;
-    substeps_window_max_ = 1;
-    substeps_set_time_ = time_;
-  } else {
-    substeps_window_max_ = std::max(substeps_window_max_, needed);
-    if (step_start && time_ - substeps_set_time_ >= hold * (1.0 - 1e-9)) {
-      substeps_ = substeps_window_max_;
-      substeps_window_max_ = 1;
-      substeps_set_time_ = time_;
-    }
-  }
+  substeps_ = substep_rule_.update(wanted, time_, dt, step_start);
 }
 
 void Simulation::step() {
@@ -234,6 +183,7 @@ void Simulation::step() {
     record.residual = std::max(record.residual, report.residual);
   };
   update_forces(time_, dt, true);
+  if (steps_ == 0) outcomes_.sample(scene_, time_, dt, *world_, *magnetics_);  // t = 0, relaxed
   update_substeps(dt, true, record);
   // Substeps, each with its own forces: holding one step's forces over
   // several substeps is not symplectic and makes resting contacts unstable
@@ -260,7 +210,7 @@ void Simulation::step() {
   records_.push_back(record);
   time_ += dt;
   ++steps_;
-  evaluate_outcomes(false);
+  outcomes_.sample(scene_, time_, dt, *world_, *magnetics_);
 }
 
 void Simulation::advance_to(double t) {
@@ -268,24 +218,7 @@ void Simulation::advance_to(double t) {
   while (time_ + 0.5 * dt < t) step();
 }
 
-void Simulation::finish() { evaluate_outcomes(true); }
-
-void Simulation::evaluate_outcomes(bool end) {
-  for (const OutcomeDescription& o : scene_.outcomes) {
-    if (outcomes_.count(o.name)) continue;
-    const bool due = o.time < 0.0 ? end : time_ + 0.5 * scene_.simulation.time_step >= o.time;
-    if (due) outcomes_[o.name] = count_above(o.prefix, o.height);
-  }
-}
-
-int Simulation::count_above(const std::string& prefix, double height) const {
-  int count = 0;
-  for (int b = 0; b < world_->body_count(); ++b) {
-    if (!world_->enabled(b) || scene_.bodies[b].name.rfind(prefix, 0) != 0) continue;
-    if (world_->pose(b).position.z > height) ++count;
-  }
-  return count;
-}
+void Simulation::finish() { outcomes_.finish(scene_, *world_, *magnetics_); }
 
 bool Simulation::finite_state(int b) const {
   const BodyPose p = world_->pose(b);

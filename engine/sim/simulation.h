@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "engine/ode/magnetic_forces.h"
+#include "engine/ode/substeps.h"
+#include "engine/sim/outcomes.h"
 #include "engine/sim/rigid_world.h"
 #include "engine/scene/scene.h"
 
@@ -53,12 +55,12 @@ class Simulation {
   const MagneticForces& magnetics() const { return *magnetics_; }
   const std::vector<StepRecord>& records() const { return records_; }
 
-  // Scene outcome numbers (SceneDescription::outcomes): each is evaluated the
-  // first time the simulation reaches its time, end-of-run ones by finish().
-  const std::map<std::string, double>& outcomes() const { return outcomes_; }
+  // Scene outcome numbers (SceneDescription::outcomes, engine/sim/outcomes.h):
+  // each is taken the first time the simulation reaches its time (t = 0 with
+  // the magnetization relaxed, then after every rigid step), statistics over
+  // every step; end-of-run ones by finish().
+  const std::map<std::string, double>& outcomes() const { return outcomes_.values(); }
   void finish();
-  // Bodies whose names start with prefix and whose centre is above height.
-  int count_above(const std::string& prefix, double height) const;
   // A body's state is finite (no NaN or infinity in pose, velocity, force).
   bool finite_state(int body) const;
   // The NaN guard of `odemag run` (docs/hard-cases.md): empty while every
@@ -71,14 +73,13 @@ class Simulation {
 
  private:
   void apply_timeline(double dt);
-  // Substeps needed for collision (travel) and for the magnetic force's time
-  // scale (stiffness), before the cap SimulationSettings::max_substeps.
-  int substeps_needed(double dt) const;
-  // Sets substeps_ from substeps_needed (capped): raised at once, lowered
-  // only at a step's start after a hold time (simulation.cpp); notes the
+  // Substeps the rule (engine/ode/substeps.h) wants now, before the cap
+  // SimulationSettings::max_substeps.
+  int substeps_needed(double dt);
+  // Sets substeps_ from substeps_needed through the rule (capped: raised at
+  // once, lowered only at a step's start after a hold time); notes the
   // uncapped need in record.substeps_wanted.
   void update_substeps(double dt, bool step_start, StepRecord& record);
-  void evaluate_outcomes(bool end);
   // Records the first body whose state is not finite (non_finite_message).
   void note_non_finite(double t);
 
@@ -88,23 +89,18 @@ class Simulation {
   double time_ = 0.0;
   long steps_ = 0;
   std::vector<StepRecord> records_;
-  std::map<std::string, double> outcomes_;
+  OutcomeRecorder outcomes_;
   // Per event: pending, running (a ramp), done. Ramps start from the value
   // the quantity had when the event began.
   enum EventState : char { kPending, kRunning, kDone };
   std::vector<char> event_state_;
   std::vector<double> ramp_start_scale_;
   std::vector<Vec3> ramp_start_field_;
-  // Substep count in use, and the largest count needed since it was last
-  // set (it falls only after a hold time; see update_substeps).
+  // The substep rule (docs/simulation.md "Substeps"), one body per scene
+  // body, its hold state, and the count in use.
+  SubstepRule substep_rule_;
+  std::vector<SubstepMotion> substep_motion_;
   int substeps_ = 1;
-  int substeps_window_max_ = 1;
-  double substeps_set_time_ = 0.0;
-  std::vector<double> body_size_;  // smallest half-extent of each body, m
-  // Farthest surface point that a rotation moves (0 for a sphere), m.
-  std::vector<double> body_reach_;
-  std::vector<double> body_inertia_;       // smallest principal moment of inertia, kg m^2
-  std::vector<char> body_turns_in_field_;  // a uniform field exerts a torque on it
   // The first body found non-finite (-1 while none), its step and time.
   int non_finite_body_ = -1;
   long non_finite_step_ = 0;

@@ -107,7 +107,7 @@ const std::map<std::string, std::string> kKeyTables = {
     {"", "Top level"},           {"materials.permanent", "permanent"}, {"materials.soft", "soft"},
     {"materials.inert", "inert"}, {"bodies[]", "Bodies"},              {"solver", "solver"},
     {"simulation", "simulation"}, {"simulation.contact", "contact"},   {"camera", "camera"},
-    {"render", "render"},         {"outcomes[]", "outcomes"},
+    {"render", "render"},         {"outcomes[]", "outcomes"},           {"joints[]", "joints"},
 };
 // The objects the docs describe in prose under a heading.
 const std::map<std::string, std::string> kProse = {
@@ -115,6 +115,12 @@ const std::map<std::string, std::string> kProse = {
     {"bodies[].shape.cylinder", "Bodies"},
     {"timeline[].keys[]", "timeline"},
     {"outcomes[].count_above", "outcomes"},
+    {"outcomes[].distance", "outcomes"},
+    {"outcomes[].height", "outcomes"},
+    {"outcomes[].speed", "outcomes"},
+    {"outcomes[].contact_count", "outcomes"},
+    {"outcomes[].force", "outcomes"},
+    {"outcomes[].moment", "outcomes"},
 };
 const std::string kEventPrefix = "timeline[].";
 

@@ -441,5 +441,47 @@ TEST(SceneParser, MissingFileNamesTheFile) {
   }
 }
 
+// Joints: each type takes its own keys; bodies must exist, differ and not all be fixed.
+TEST(SceneParser, JointsAreReadAndCheckedPerType) {
+  const std::string two = R"([{"name": "a", "shape": {"sphere": 0.01}, "material": "m", "fixed": true},
+                              {"name": "b", "shape": {"sphere": 0.01}, "material": "m"}])";
+  auto with_joints = [&](const std::string& joints) {
+    std::string text = bodies_scene(two);
+    return text.substr(0, text.size() - 1) + R"(, "joints": )" + joints + "}";
+  };
+  const SceneDescription s = parse_scene(
+      with_joints(R"([{"type": "hinge", "bodies": ["b", "a"], "anchor": [0, 0, 0.01], "axis": [1, 0, 0],
+                       "limits": [-0.5, 1]}, {"type": "slider", "bodies": ["b"]}])"),
+      "ok.json");
+  ASSERT_EQ(s.joints.size(), 2u);
+  EXPECT_EQ(s.joints[0].type, JointDescription::Type::hinge);
+  EXPECT_EQ(s.joints[0].bodies, (std::vector<std::string>{"b", "a"}));
+  EXPECT_EQ(s.joints[0].anchor.z, 0.01);
+  EXPECT_EQ(s.joints[0].axis.x, 1.0);
+  ASSERT_TRUE(s.joints[0].limits.has_value());
+  EXPECT_EQ((*s.joints[0].limits)[1], 1.0);
+  EXPECT_EQ(s.joints[1].axis.z, 1.0);  // the default axis
+  EXPECT_FALSE(s.joints[1].limits.has_value());
+
+  expect_key(with_joints(R"([{"type": "hinge", "bodies": ["c"], "anchor": [0, 0, 0]}])"), "joints[0].bodies[0]");
+  expect_key(with_joints(R"([{"type": "ball", "bodies": ["b", "b"], "anchor": [0, 0, 0]}])"), "joints[0].bodies[1]");
+  expect_key(with_joints(R"([{"type": "ball", "bodies": ["a"], "anchor": [0, 0, 0]}])"), "joints[0].bodies");
+  expect_key(with_joints(R"([{"type": "fixed", "bodies": ["a", "b", "b"]}])"), "joints[0].bodies");
+  expect_key(with_joints(R"([{"type": "hinge", "bodies": ["b"]}])"), "joints[0].anchor");
+  expect_key(with_joints(R"([{"type": "slider", "bodies": ["b"], "anchor": [0, 0, 0]}])"), "joints[0].anchor");
+  expect_key(with_joints(R"([{"type": "ball", "bodies": ["b"], "anchor": [0, 0, 0], "axis": [0, 0, 1]}])"),
+             "joints[0].axis");
+  expect_key(with_joints(R"([{"type": "ball", "bodies": ["b"], "anchor": [0, 0, 0], "limits": [0, 1]}])"),
+             "joints[0].limits");
+  expect_key(with_joints(R"([{"type": "hinge", "bodies": ["b"], "anchor": [0, 0, 0], "limits": [1, 0]}])"),
+             "joints[0].limits");
+  expect_key(with_joints(R"([{"type": "hinge", "bodies": ["b"], "anchor": [0, 0, 0], "limits": [-4, 0]}])"),
+             "joints[0].limits[0]");
+  expect_key(with_joints(R"([{"type": "hinge", "bodies": ["b"], "anchor": [0, 0, 0], "axis": [0, 0, 0]}])"),
+             "joints[0].axis");
+  expect_key(with_joints(R"([{"type": "weld", "bodies": ["b"]}])"), "joints[0].type");
+  expect_key(with_joints(R"([{"type": "fixed", "bodies": ["b"], "strength": 1}])"), "joints[0].strength");
+}
+
 }  // namespace
 }  // namespace odemag

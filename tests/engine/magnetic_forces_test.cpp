@@ -11,6 +11,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -19,6 +20,7 @@
 #include "engine/ode/magnetic_forces.h"
 #include "engine/scene/scene.h"
 #include "engine/sim/magnetic_system.h"
+#include "magnetics/constants.h"
 
 namespace odemag {
 namespace {
@@ -420,6 +422,144 @@ TEST(MagneticForcesWake, DisabledByTheProgramStaysDisabled) {
   }
   EXPECT_FALSE(dBodyIsEnabled(w.ball));
   EXPECT_THROW(w.magnetics.set_wake_tolerance(-1.0), std::invalid_argument);
+}
+
+// Saving and restoring the magnetic state (docs/embedding.md "Saving and
+// restoring"): a nail with anisotropy (a remanent soft body) magnetized by a
+// field along its easy axis keeps a moment when the field is gone; a reverse
+// field takes it away; restoring the saved state brings it back exactly, and
+// the next compute() gives the forces of a run that was never demagnetized.
+// Bit for bit.
+void expect_same(const Vec3& a, const Vec3& b) {
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.z, b.z);
+}
+
+struct RemanentNail {
+  RemanentNail() {
+    SoftMaterial steel;
+    steel.saturation = 1.6e6;
+    steel.susceptibility = 1000;
+    steel.anisotropy_field = 8e4;
+    steel.easy_axis = {0, 0, 1};
+    steel.moments_per_cell = 8;
+    nail = magnetics.attach(nullptr, Cylinder{0.002, 0.02}, steel, 0.002, "nail");
+    magnetics.set_pose(nail, BodyPose{Mat3{}, {0, 0, 0}});
+    SoftMaterial iron;
+    iron.saturation = 1.7e6;
+    iron.susceptibility = 5000;
+    ball = magnetics.attach(nullptr, Sphere{0.003}, iron, 0.0, "ball");
+    magnetics.set_pose(ball, BodyPose{Mat3{}, {0, 0, 0.0135}});  // 0.5 mm beyond the nail's tip
+  }
+  // A field H along z held for n steps, then removed for n steps.
+  void pulse(double H, int n = 20) {
+    magnetics.set_external_field({0, 0, H});
+    for (int i = 0; i < n; ++i) magnetics.compute();
+    magnetics.set_external_field({});
+    for (int i = 0; i < n; ++i) magnetics.compute();
+  }
+  MagneticForces magnetics{{}, make_cpu_backend(1)};
+  int nail = 0, ball = 0;
+};
+
+TEST(MagneticForcesState, RemanenceSurvivesSaveAndRestore) {
+  RemanentNail a, b;  // b: the run that is never demagnetized
+  a.pulse(3e5);
+  b.pulse(3e5);
+  const Vec3 remanent = a.magnetics.moment(a.nail);
+  ASSERT_GT(remanent.z, 0.1 * 1.6e6 * kPi * 0.002 * 0.002 * 0.02) << "magnetized: a remanent moment";
+  const SavedMagneticState saved = a.magnetics.save_state();
+  a.pulse(-3e5);  // reversed
+  ASSERT_LT(a.magnetics.moment(a.nail).z, 0.0);
+  a.magnetics.restore_state(saved);
+  expect_same(a.magnetics.moment(a.nail), remanent);
+  EXPECT_EQ(a.magnetics.external_field().z, 0.0);
+  a.magnetics.compute();
+  b.magnetics.compute();
+  for (int i : {a.nail, a.ball}) {
+    expect_same(a.magnetics.force(i), b.magnetics.force(i));
+    expect_same(a.magnetics.torque(i), b.magnetics.torque(i));
+  }
+  EXPECT_LT(a.magnetics.force(a.ball).z, 0.0) << "pulled to the nail by its remanence";
+}
+
+TEST(MagneticForcesState, RestoreIntoOtherMagneticsThrows) {
+  RemanentNail a;
+  const SavedMagneticState saved = a.magnetics.save_state();
+  MagneticForces fewer;  // one body
+  fewer.attach(nullptr, Sphere{0.003}, PermanentMaterial{{0, 0, 1e6}});
+  EXPECT_THROW(fewer.restore_state(saved), std::invalid_argument);
+  MagneticForces coarser;  // two bodies, the nail in other cells
+  SoftMaterial steel;
+  steel.saturation = 1.6e6;
+  steel.susceptibility = 1000;
+  coarser.attach(nullptr, Cylinder{0.002, 0.02}, steel, 0.004, "nail");
+  coarser.attach(nullptr, Sphere{0.003}, steel, 0.0, "ball");
+  try {
+    coarser.restore_state(saved);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("\"nail\""), std::string::npos) << e.what();
+  }
+  SavedMagneticState edited = saved;  // arrays that do not fit
+  edited.state.moments.pop_back();
+  EXPECT_THROW(a.magnetics.restore_state(edited), std::invalid_argument);
+  EXPECT_NO_THROW(a.magnetics.restore_state(saved));
+}
+
+// A scene file's materials on an embedder's own ODE bodies (docs/embedding.md
+// "Materials from a scene file"): the same force as the materials built in C++.
+TEST(MagneticForcesMaterials, SceneMaterialGivesTheSameForceAsOneBuiltInCpp) {
+  const SceneDescription scene = parse_scene(R"({
+    "materials": {
+      "magnet": {"type": "permanent", "magnetization": [0, 0, 900000]},
+      "steel": {"type": "soft", "saturation": 1.6e6, "susceptibility": 1000, "anisotropy_field": 80000,
+                "easy_axis": [0, 0, 1], "moments_per_cell": 4}
+    },
+    "bodies": [{"name": "unused", "shape": {"sphere": 0.001}, "material": "magnet"}]
+  })", "materials.json");
+  SoftMaterial steel;
+  steel.saturation = 1.6e6;
+  steel.susceptibility = 1000;
+  steel.anisotropy_field = 8e4;
+  steel.easy_axis = {0, 0, 1};
+  steel.moments_per_cell = 4;
+  const PermanentMaterial magnet{{0, 0, 9e5}};
+  OdeWorld w;
+  Vec3 force[2], torque[2];
+  for (int run = 0; run < 2; ++run) {
+    MagneticForces magnetics({}, make_cpu_backend(1));
+    dBodyID bar = w.body_at({0, 0, 0});
+    dBodyID rod = w.body_at({0.002, 0, 0.0205});
+    if (run == 0) {
+      magnetics.attach(bar, Box{{0.01, 0.01, 0.02}}, scene.materials, "magnet", 0.005);
+      magnetics.attach(rod, Cylinder{0.002, 0.02}, scene.materials, "steel", 0.002);
+    } else {
+      magnetics.attach(bar, Box{{0.01, 0.01, 0.02}}, magnet, 0.005);
+      magnetics.attach(rod, Cylinder{0.002, 0.02}, steel, 0.002);
+    }
+    magnetics.compute();
+    force[run] = magnetics.force(1);
+    torque[run] = magnetics.torque(1);
+  }
+  EXPECT_GT(norm(force[0]), 0.0);
+  expect_same(force[0], force[1]);
+  expect_same(torque[0], torque[1]);
+}
+
+TEST(MagneticForcesMaterials, UnknownMaterialThrowsNamingIt) {
+  const std::map<std::string, Material> materials{{"iron", SoftMaterial{}}, {"magnet", PermanentMaterial{}}};
+  MagneticForces magnetics;
+  try {
+    magnetics.attach(nullptr, Sphere{0.003}, materials, "steel");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("\"steel\""), std::string::npos) << what;
+    EXPECT_NE(what.find("\"iron\", \"magnet\""), std::string::npos) << what;
+  }
+  EXPECT_EQ(magnetics.body_count(), 0);
 }
 
 }  // namespace

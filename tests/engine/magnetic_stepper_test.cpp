@@ -1,0 +1,200 @@
+// The embedder's substepping (engine/ode/magnetic_stepper.h, docs/embedding.md
+// "Substeps"): the world of demos/embed_minimal.cpp, an iron ball pulled to a
+// bar magnet's pole, stepped with MagneticStepper ends with the ball resting
+// on the magnet, where the plain loop (apply(); collide; quickstep) either
+// sinks it by the contact surface layer or, without one, throws it away;
+// with one substep the stepper is that plain loop, bit for bit.
+#include <gtest/gtest.h>
+
+#include <ode/ode.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "engine/ode/magnetic_forces.h"
+#include "engine/ode/magnetic_stepper.h"
+#include "engine/ode/substeps.h"
+#include "magnetics/constants.h"
+
+namespace odemag {
+namespace {
+
+constexpr double kRadius = 0.005;  // the ball's, m
+constexpr double kStep = 0.001;    // rigid step, s
+
+// demos/embed_minimal.cpp's world: a 4 x 1 x 1 cm bar magnet (M_r 8e5 A/m
+// along x) lying on the ground as a static geom, and an iron ball of radius
+// 5 mm released 2 cm beyond its north pole, 3 cm up.
+struct EmbedWorld {
+  explicit EmbedWorld(double surface_layer) {
+    dInitODE();
+    world = dWorldCreate();
+    dWorldSetGravity(world, 0, 0, -9.81);
+    dWorldSetContactSurfaceLayer(world, surface_layer);
+    space = dHashSpaceCreate(nullptr);
+    contacts = dJointGroupCreate(0);
+    dCreatePlane(space, 0, 0, 1, 0);
+    dGeomSetPosition(dCreateBox(space, 0.04, 0.01, 0.01), 0, 0, 0.005);
+    const int bar = magnetics.attach(nullptr, Box{{0.04, 0.01, 0.01}}, PermanentMaterial{{8e5, 0, 0}}, 0.005, "bar");
+    magnetics.set_pose(bar, BodyPose{Mat3{}, {0, 0, 0.005}});
+    ball = dBodyCreate(world);
+    dMass mass;
+    dMassSetSphere(&mass, 7870, kRadius);
+    dBodySetMass(ball, &mass);
+    dBodySetPosition(ball, 0.04, 0, 0.03);
+    dGeomSetBody(dCreateSphere(space, kRadius), ball);
+    SoftMaterial iron;
+    iron.saturation = 1.7e6;
+    iron.susceptibility = 5000;
+    magnetics.attach(ball, Sphere{kRadius}, iron, 0.0, "ball");
+  }
+  ~EmbedWorld() {
+    dJointGroupDestroy(contacts);
+    dSpaceDestroy(space);
+    dWorldDestroy(world);
+    dCloseODE();
+  }
+  static void near_callback(void* data, dGeomID a, dGeomID b) {
+    auto* w = static_cast<EmbedWorld*>(data);
+    if (!dGeomGetBody(a) && !dGeomGetBody(b)) return;
+    dContact contact[4] = {};
+    const int n = dCollide(a, b, 4, &contact[0].geom, sizeof(dContact));
+    for (int i = 0; i < n; ++i) {
+      contact[i].surface.mode = dContactBounce;
+      contact[i].surface.mu = 0.5;
+      contact[i].surface.bounce = 0.1;
+      dJointAttach(dJointCreateContact(w->world, w->contacts, &contact[i]), dGeomGetBody(a), dGeomGetBody(b));
+    }
+  }
+  // The loop of docs/embedding.md "The API in one loop", one substep per step.
+  void plain_step() {
+    magnetics.apply();
+    dSpaceCollide(space, this, &near_callback);
+    dWorldQuickStep(world, kStep);
+    dJointGroupEmpty(contacts);
+  }
+  MagneticStepper stepper(const StepperSettings& settings = {}) {
+    return MagneticStepper(magnetics, world, space, &near_callback, this, contacts, settings);
+  }
+  // Ball surface to the magnet's surface, m (negative: inside).
+  double gap() const {
+    const dReal* p = dBodyGetPosition(ball);
+    const double dx = std::max(std::abs(p[0]) - 0.02, 0.0), dy = std::max(std::abs(p[1]) - 0.005, 0.0),
+                 dz = std::max(std::abs(p[2] - 0.005) - 0.005, 0.0);
+    return std::sqrt(dx * dx + dy * dy + dz * dz) - kRadius;
+  }
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  dBodyID ball;
+  MagneticForces magnetics{{}, make_cpu_backend(1)};
+};
+
+// Touching within a thousandth of the ball's radius counts as resting on the
+// magnet (ODE's contacts leave F h CFM / ERP, well under a micrometre here).
+constexpr double kTouching = 1e-3 * kRadius;
+
+TEST(MagneticStepper, EmbedMinimalBallRestsOnTheMagnet) {
+  EmbedWorld w(0.0);  // no contact surface layer: substeps keep the contact
+  MagneticStepper stepper = w.stepper();
+  int most = 1;
+  for (int i = 0; i < 2000; ++i) most = std::max(most, stepper.step(kStep).substeps);
+  EXPECT_NEAR(w.gap(), 0.0, kTouching) << "ball at x = " << dBodyGetPosition(w.ball)[0];
+  EXPECT_GT(norm(w.magnetics.force(1)), 100.0 * 7870 * 4.0 / 3.0 * kPi * std::pow(kRadius, 3) * 9.81)
+      << "held by the pole";
+  EXPECT_GT(most, 1) << "the rule split the steps of the approach";
+  EXPECT_NEAR(stepper.time(), 2.0, 1e-9);
+}
+
+TEST(MagneticStepper, PlainLoopSinksOrThrowsTheBallAway) {
+  {
+    // As demos/embed_minimal.cpp did: the surface layer keeps the contact
+    // but lets the ball sink in by its thickness, 0.1 mm.
+    EmbedWorld w(1e-4);
+    for (int i = 0; i < 2000; ++i) w.plain_step();
+    EXPECT_LT(w.gap(), -0.9e-4);
+  }
+  {
+    // Without it the contact flickers and the pull throws the ball out.
+    EmbedWorld w(0.0);
+    for (int i = 0; i < 2000; ++i) w.plain_step();
+    EXPECT_GT(w.gap(), 1e-3);
+  }
+}
+
+// max_substeps 1: the stepper is the plain loop, bit for bit. (Each run from
+// the same seed of ODE's random number generator, which dWorldQuickStep
+// uses to order the constraints.)
+TEST(MagneticStepper, OneSubstepIsThePlainLoop) {
+  EmbedWorld plain(1e-4), stepped(1e-4);
+  dRandSetSeed(1);
+  for (int i = 0; i < 300; ++i) plain.plain_step();
+  StepperSettings one;
+  one.substeps.max_substeps = 1;
+  MagneticStepper stepper = stepped.stepper(one);
+  dRandSetSeed(1);
+  for (int i = 0; i < 300; ++i) {
+    const StepReport& r = stepper.step(kStep);
+    ASSERT_EQ(r.substeps, 1);
+    ASSERT_EQ(r.relaxations, 1);
+  }
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(dBodyGetPosition(plain.ball)[k], dBodyGetPosition(stepped.ball)[k]);
+    EXPECT_EQ(dBodyGetLinearVel(plain.ball)[k], dBodyGetLinearVel(stepped.ball)[k]);
+  }
+  EXPECT_LT(plain.gap(), 0.0) << "touching after 0.3 s";
+}
+
+// magnetic_solve "step": one relaxation per rigid step, the other substeps
+// at the held magnetization; still rests on the magnet.
+TEST(MagneticStepper, OneRelaxationPerStep) {
+  EmbedWorld w(0.0);
+  StepperSettings settings;
+  settings.magnetic_solve = MagneticSolve::step;
+  MagneticStepper stepper = w.stepper(settings);
+  bool split = false;
+  for (int i = 0; i < 2000; ++i) {
+    const StepReport& r = stepper.step(kStep);
+    ASSERT_EQ(r.relaxations, 1);
+    split = split || r.substeps > 1;
+  }
+  EXPECT_TRUE(split);
+  EXPECT_NEAR(w.gap(), 0.0, kTouching);
+}
+
+// The rule: a body at rest far from anything needs one substep; a fast one
+// near its size's travel more; the count falls only at a step's start after
+// the hold time 2 pi dt / stiffness_limit.
+TEST(SubstepRule, TravelBoundAndHold) {
+  SubstepRule rule;
+  rule.add_body({0.005, 0.0, 1e-9, false});
+  std::vector<SubstepMotion> motion(1);
+  motion[0].free = true;
+  motion[0].mass = 0.004;
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 1);
+  motion[0].velocity = {5.0, 0, 0};  // 5 mm per step: ten substeps of 0.5 mm
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 10);
+  motion[0].free = false;  // kinematic or disabled: not counted
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 1);
+  EXPECT_EQ(rule.update(10, 0.0, 0.001, true), 10);
+  EXPECT_EQ(rule.update(2, 0.001, 0.001, true), 10) << "held";
+  EXPECT_EQ(rule.update(1, 0.001, 0.001, false), 10);
+  EXPECT_EQ(rule.update(1, 2.0 * kPi * 0.001, 0.001, false), 10) << "only at a step's start";
+  EXPECT_EQ(rule.update(1, 2.0 * kPi * 0.001, 0.001, true), 2) << "the largest needed meanwhile";
+  EXPECT_EQ(rule.update(1000, 0.01, 0.001, false), 64) << "capped at max_substeps";
+}
+
+TEST(MagneticStepper, BadArgumentsThrow) {
+  EmbedWorld w(0.0);
+  EXPECT_THROW(MagneticStepper(w.magnetics, nullptr, w.space, &EmbedWorld::near_callback, &w, w.contacts),
+               std::invalid_argument);
+  EXPECT_THROW(MagneticStepper(w.magnetics, w.world, w.space, nullptr, &w, w.contacts), std::invalid_argument);
+  MagneticStepper stepper = w.stepper();
+  for (double dt : {0.0, -0.001, std::numeric_limits<double>::infinity(), std::nan("")})
+    EXPECT_THROW(stepper.step(dt), std::invalid_argument) << dt;
+}
+
+}  // namespace
+}  // namespace odemag

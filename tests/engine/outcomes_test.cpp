@@ -1,0 +1,72 @@
+// Scene outcomes (docs/scene-format.md "outcomes"): each quantity at a time,
+// at the end, and as the largest or smallest value over the run, for a steel
+// ball that falls onto a magnet and stays there.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "engine/sim/simulation.h"
+#include "magnetics/constants.h"
+#include "tests/support/scene_builders.h"
+
+namespace odemag {
+namespace {
+
+using test_support::body;
+using test_support::steel;
+
+OutcomeDescription outcome(const std::string& name, OutcomeDescription::Quantity q, std::vector<std::string> bodies,
+                           double time = -1.0, const std::string& statistic = "") {
+  OutcomeDescription o;
+  o.name = name;
+  o.quantity = q;
+  o.bodies = std::move(bodies);
+  o.time = time;
+  o.statistic = statistic;
+  return o;
+}
+
+TEST(Outcomes, EachQuantityAtATimeAtTheEndAndOverTheRun) {
+  using Q = OutcomeDescription::Quantity;
+  const double R = 0.008, r = 0.005, z0 = 0.045;
+  SceneDescription s;
+  s.file = "outcomes";
+  s.simulation.time_step = 0.002;
+  s.materials["magnet"] = PermanentMaterial{{0, 0, 9e5}, 0.0};
+  s.materials["steel"] = steel();
+  s.bodies.push_back(body("magnet", Sphere{R}, "magnet", {0, 0, R}, true));
+  s.bodies.push_back(body("ball", Sphere{r}, "steel", {0, 0, z0}));
+  s.outcomes = {outcome("start_height", Q::height, {"ball"}, 0.0),
+                outcome("closest", Q::distance, {"ball", "magnet"}, -1.0, "min"),
+                outcome("farthest", Q::distance, {"ball", "magnet"}, -1.0, "max"),
+                outcome("fastest", Q::speed, {"ball"}, -1.0, "max"),
+                outcome("contacts", Q::contact_count, {"ball"}),
+                outcome("pull_z", Q::force, {"ball"}),
+                outcome("moment", Q::moment, {"ball"}),
+                outcome("never", Q::height, {"ball"}, 99.0)};
+  s.outcomes[5].component = 2;
+  OutcomeDescription held;
+  held.name = "held";
+  held.prefix = "ba";
+  held.height = 2 * R;
+  s.outcomes.push_back(held);
+  Simulation sim(s);
+  sim.advance_to(1.0);
+  sim.finish();
+  const auto& v = sim.outcomes();
+  EXPECT_EQ(v.at("start_height"), z0);
+  // Touching: centres R + r apart, within the collision skin (2% of r per body).
+  EXPECT_NEAR(v.at("closest"), R + r, 0.05 * r);
+  EXPECT_NEAR(v.at("farthest"), z0 - R, 1e-12);  // where it started
+  // It fell at least z0 - (2 R + r) under gravity alone, faster with the pull.
+  EXPECT_GT(v.at("fastest"), std::sqrt(2 * 9.81 * (z0 - 2 * R - r)));
+  EXPECT_GE(v.at("contacts"), 1.0);
+  EXPECT_EQ(v.at("pull_z"), sim.magnetics().force(1).z);
+  EXPECT_LT(v.at("pull_z"), 0.0);  // towards the magnet below
+  EXPECT_EQ(v.at("moment"), norm(sim.magnetics().moment(1)));
+  EXPECT_EQ(v.at("held"), 1.0);
+  EXPECT_EQ(v.count("never"), 0u);  // a time the run did not reach
+}
+
+}  // namespace
+}  // namespace odemag
