@@ -6,7 +6,8 @@
 // Coherence of host and device state (docs/gpu.md "Host and device state"):
 // - Geometry (positions, radii, bodies, rotations, lattice keys, moment
 //   offsets) is uploaded by begin_step, once per rigid step; the offset tensor
-//   tables once per model.
+//   tables once per model contents (MagneticModel::generation: a copy, a new
+//   model at the same address or an added body uploads them again).
 // - Magnetizations belong to the host: responsive_field and forces upload
 //   state.magnetization of the cells they read at every call (the relaxation
 //   driver and place_cells write it on the host).
@@ -23,6 +24,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -117,31 +120,14 @@ class CallTimer {
   int recorded_ = 0;
 };
 
-// Identity of the model's offset tensor tables: they are uploaded again only
-// when this changes (another model, bodies added, ...). Each table's address
-// and size, and a few of its values in case a new model reuses the memory.
-struct TableKey {
-  const MagneticModel* model = nullptr;
-  std::vector<const double*> data;
-  std::vector<size_t> size;
-  std::vector<double> samples;
-  bool operator==(const TableKey&) const = default;
-};
-
-TableKey table_key(const MagneticModel& model) {
-  TableKey key;
-  key.model = &model;
-  for (const MagneticBody& body : model.bodies()) {
-    const std::vector<double>& t = body.offset_tensors;
-    key.data.push_back(t.data());
-    key.size.push_back(t.size());
-    if (!t.empty()) {
-      key.samples.push_back(t.front());
-      key.samples.push_back(t[t.size() / 2]);
-      key.samples.push_back(t.back());
-    }
-  }
-  return key;
+// The one line the CUDA backend writes when asked for the far-field
+// approximation (RelaxOptions::far_field_theta > 0), which it does not have.
+void print_far_field_notice(double theta) {
+  std::fprintf(stderr,
+               "odemag: the CUDA backend ignores solver.far_field_theta (%g: the far-field approximation is "
+               "CPU-only); every pair is summed exactly\n",
+               theta);
+  std::fflush(stderr);
 }
 
 template <class T>
@@ -154,6 +140,16 @@ class CudaBackend final : public MagneticBackend {
   explicit CudaBackend(int device) : device_(select(device)) { totals_.resize(1); }
 
   std::string name() const override { return "cuda"; }
+
+  // No far-field tree on the device: every pair is summed exactly. Said once
+  // per backend on stderr, the first time theta > 0 is asked for (the
+  // relaxation driver sets it at every step).
+  void set_far_field(double theta) override {
+    if (theta > 0.0 && !far_field_noticed_) {
+      far_field_noticed_ = true;
+      print_far_field_notice(theta);
+    }
+  }
 
   CudaBackendStats stats() const { return stats_; }
   void reset_stats() { stats_ = {}; }
@@ -470,8 +466,8 @@ class CudaBackend final : public MagneticBackend {
   // The offset tensors of every body in one device array, uploaded when the
   // model's tables changed. Returns the bytes uploaded.
   double upload_tables(const MagneticModel& model) {
-    TableKey key = table_key(model);
-    if (key == table_key_ && table_offset_.size() == static_cast<size_t>(model.body_count())) return 0.0;
+    if (model.generation() == table_generation_ && table_offset_.size() == static_cast<size_t>(model.body_count()))
+      return 0.0;
     std::vector<double> tables;
     table_offset_.assign(model.body_count(), -1);
     for (int b = 0; b < model.body_count(); ++b) {
@@ -481,12 +477,13 @@ class CudaBackend final : public MagneticBackend {
       tables.insert(tables.end(), t.begin(), t.end());
     }
     tables_.upload(tables.data(), tables.size(), stream());
-    table_key_ = std::move(key);
+    table_generation_ = model.generation();
     return bytes_of<double>(tables.size());
   }
 
   int device_;
   bool near_field_ = true, near_mutual_induction_ = true;
+  bool far_field_noticed_ = false;
   NearField near_;
   std::vector<Vec3> near_force_, near_field_at_;
   Stream stream_;
@@ -499,7 +496,7 @@ class CudaBackend final : public MagneticBackend {
   std::vector<Vec3> all_positions_;
   std::vector<MomentRun> moment_runs_;
   size_t moment_total_ = 0;
-  TableKey table_key_;
+  uint64_t table_generation_ = 0;  // MagneticModel::generation of the uploaded tables; 0: none (never a generation)
   std::vector<long long> table_offset_;  // per body, into tables_; -1: none
 
   // Host staging of begin_step (pageable; once per step).

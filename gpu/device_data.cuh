@@ -100,7 +100,7 @@ void launch_responsive_field(const ResponsiveFieldArgs& a, cudaStream_t stream);
 struct RelaxTotals {
   unsigned long long llg_steps;
   unsigned long long newton_steps;
-  unsigned long long max_residual_bits;  // bits of the largest residual (>= 0 orders as integer)
+  unsigned long long max_residual_bits;  // bits of the largest residual (>= 0 orders as integer; NaN above all)
 };
 
 // Local relaxation of every responsive cell under its frozen H_A (relax_cells).

@@ -12,6 +12,11 @@ namespace odemag::gpu {
 
 namespace {
 
+// Bits of a quiet NaN. Above the bits of every non-negative double (+inf is
+// 0x7ff0...), so the integer maximum below keeps it: a cell whose residual or
+// magnetization is not finite makes the call's largest residual NaN, as on
+// the CPU (cpu_backend.cpp), and the relaxation then fails (relax.cpp).
+constexpr unsigned long long kNaNBits = 0x7ff8000000000000ULL;
 
 __device__ unsigned long long larger(unsigned long long a, unsigned long long b) { return a > b ? a : b; }
 
@@ -22,6 +27,7 @@ __global__ void __launch_bounds__(kThreadsPerBlock) relax_cells_kernel(RelaxCell
     const DeviceBody& b = a.bodies[a.body[i]];
     if (b.kind == static_cast<int>(CellKind::recoil_permanent)) {
       a.magnetization[i] = recoil_magnetization(b.remanent, b.recoil, a.applied[i]);
+      if (!is_finite(a.magnetization[i])) worst = kNaNBits;
     } else {
       const int off = a.moment[i];
       bool history = a.history[i] != 0;
@@ -31,11 +37,14 @@ __global__ void __launch_bounds__(kThreadsPerBlock) relax_cells_kernel(RelaxCell
           counter, noise_stream(a.seed, static_cast<uint64_t>(a.cell[i])), a.options);
       a.history[i] = history ? 1 : 0;
       a.counter[i] = counter;
-      a.magnetization[i] = b.rotation * (b.soft.Ms * mean_moment(a.moments + off, b.soft.n));
+      const Vec3 M = b.rotation * (b.soft.Ms * mean_moment(a.moments + off, b.soft.n));
+      a.magnetization[i] = M;
       llg = static_cast<unsigned long long>(r.llg_steps);
       newton = static_cast<unsigned long long>(r.newton_steps);
-      // The CPU's std::max(worst, residual) ignores NaN: so does this (NaN > 0 is false).
-      if (r.residual > 0.0) worst = static_cast<unsigned long long>(__double_as_longlong(r.residual));
+      if (!isfinite(r.residual) || !is_finite(M))
+        worst = kNaNBits;
+      else if (r.residual > 0.0)
+        worst = static_cast<unsigned long long>(__double_as_longlong(r.residual));
     }
   }
   // Warp sums, then one atomic per warp. Every lane takes part (no early

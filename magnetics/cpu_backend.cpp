@@ -3,6 +3,8 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "magnetics/backend.h"
 #include "magnetics/cell_layout.h"
@@ -132,9 +134,12 @@ class CpuBackend final : public MagneticBackend {
   LocalStats relax_cells(const MagneticModel& model, MagneticState& state,
                          const std::vector<Vec3>& H_A, const LocalRelaxOptions& options) override {
     const int n = resp_.size();
-    long llg = 0, newton = 0;
+    long llg = 0, newton = 0, nonfinite = 0;
     double worst = 0.0;
-#pragma omp parallel for schedule(dynamic, 8) num_threads(threads_) reduction(+ : llg, newton) \
+    // A cell whose residual or magnetization is not finite (NaN moments or
+    // fields) makes the largest residual NaN: max reductions drop NaN, and a
+    // relaxation must not look converged with such cells.
+#pragma omp parallel for schedule(dynamic, 8) num_threads(threads_) reduction(+ : llg, newton, nonfinite) \
     reduction(max : worst) if (n > 16)
     for (int i = 0; i < n; ++i) {
       const int c = layout_.responsive.cell[i], b = layout_.responsive.body[i];
@@ -143,6 +148,7 @@ class CpuBackend final : public MagneticBackend {
       if (body.kind == CellKind::recoil_permanent) {
         state.magnetization[c] = recoil_magnetization(
             R * (state.magnetization_scale[b] * body.remanence), body.recoil, H_A[c]);
+        if (!is_finite(state.magnetization[c])) ++nonfinite;
         continue;
       }
       const int off = model.moment_offset(c);
@@ -154,8 +160,10 @@ class CpuBackend final : public MagneticBackend {
       state.magnetization[c] = R * (body.soft.Ms * mean_moment(&state.moments[off], body.soft.n));
       llg += r.llg_steps;
       newton += r.newton_steps;
+      if (!std::isfinite(r.residual) || !is_finite(state.magnetization[c])) ++nonfinite;
       worst = std::max(worst, r.residual);
     }
+    if (nonfinite > 0) worst = std::numeric_limits<double>::quiet_NaN();
     return {llg, newton, worst};
   }
 

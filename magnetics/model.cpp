@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -135,6 +136,11 @@ void build_boundary_correction(MagneticBody& body) {
 
 }  // namespace
 
+uint64_t ModelGeneration::next() noexcept {
+  static std::atomic<uint64_t> last{0};
+  return last.fetch_add(1, std::memory_order_relaxed) + 1;
+}
+
 double body_lattice_points(const Shape& shape, double cell_size) {
   if (!(cell_size > 0.0)) return 1.0;
   const Vec3 half = shape_half_extents(shape);
@@ -201,6 +207,7 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     if (body.responsive()) ++responsive_cells_;
   }
   bodies_.push_back(std::move(body));
+  generation_.bump();
   return body_count() - 1;
 }
 

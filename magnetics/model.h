@@ -82,11 +82,43 @@ double body_lattice_points(const Shape& shape, double cell_size);
 // cells, are the caller's to skip.
 std::string validate_body_lattice(const std::string& name, const Shape& shape, double cell_size);
 
+// A number that identifies one model's contents within the process: a new
+// one for every model made, copied or moved (both the source and the target
+// of a move get one) and after every change. Backends that cache what they
+// derive from a model (the CUDA backend's offset tensor tables) key the cache
+// on it instead of the model's address, which a copy or a new model can share.
+class ModelGeneration {
+ public:
+  ModelGeneration() : value_(next()) {}
+  ModelGeneration(const ModelGeneration&) : value_(next()) {}
+  ModelGeneration(ModelGeneration&& other) noexcept : value_(next()) { other.value_ = next(); }
+  ModelGeneration& operator=(const ModelGeneration&) {
+    value_ = next();
+    return *this;
+  }
+  ModelGeneration& operator=(ModelGeneration&& other) noexcept {
+    value_ = next();
+    other.value_ = next();
+    return *this;
+  }
+  ~ModelGeneration() = default;
+  void bump() { value_ = next(); }
+  uint64_t value() const { return value_; }
+
+ private:
+  static uint64_t next() noexcept;  // process-wide, thread-safe, never 0
+  uint64_t value_;
+};
+
 class MagneticModel {
  public:
   MagneticModel() = default;
   explicit MagneticModel(IntraBodyTensor intra_tensor) : intra_tensor_(intra_tensor) {}
   IntraBodyTensor intra_body_tensor() const { return intra_tensor_; }
+
+  // This model's contents (ModelGeneration): unique to the model object and
+  // new after every add_body.
+  uint64_t generation() const { return generation_.value(); }
 
   // Adds a body and returns its index. cell_size <= 0: one cell (spheres) or
   // one cell at the centre. Throws std::invalid_argument on a bad shape or
@@ -126,6 +158,7 @@ class MagneticModel {
   int moment_count_ = 0;
   int soft_cells_ = 0;
   int responsive_cells_ = 0;
+  ModelGeneration generation_;
 };
 
 }  // namespace odemag

@@ -61,6 +61,10 @@ void record_solve(MagneticState& state, const RelaxOptions& o, bool converged) {
   last.near_field = o.near_field;
 }
 
+// max(a, b) that keeps a NaN: once either is NaN the result is NaN (std::max
+// drops a NaN second argument). Equal to std::max(a, b) otherwise.
+double max_keeping_nan(double a, double b) { return b > a || std::isnan(b) ? b : a; }
+
 // Electromagnets: the (scaled) coil field acts on the cells of its own core.
 void add_coil_fields(const MagneticModel& model, const MagneticState& state, const std::vector<int>& cells,
                      std::vector<Vec3>& H) {
@@ -93,6 +97,9 @@ RelaxReport relax_paper(const MagneticModel& model, MagneticState& state, const 
     report.residual = s.max_residual;
     report.residual_history.push_back(s.max_residual);
     if (o.progress) o.progress(report);
+    // Non-finite cells (NaN fields or moments) take no LLG step either: a
+    // failure, not convergence.
+    if (!std::isfinite(s.max_residual)) break;
     if (s.llg_steps == 0) {
       report.converged = true;
       break;
@@ -133,6 +140,7 @@ struct OuterLoop {
   const std::vector<Vec3>& H_fixed;
   LocalRelaxOptions local;
   std::vector<Vec3> H_A, H_resp;  // by cell: the field x relaxed under; the responsive field after
+  double local_residual = 0.0;    // the last relax_cells' largest residual (NaN: non-finite cells)
 };
 
 // Applied field at each responsive cell (in the order of cells): the fixed
@@ -190,6 +198,7 @@ std::vector<Vec3> apply_map(OuterLoop& l, const std::vector<double>& x, RelaxRep
     l.local.tolerance =
         std::max(l.o.local.tolerance, std::min(1e-6, 1e-2 * report.residual_history.back()));
   const LocalStats s = l.backend.relax_cells(l.model, l.state, l.H_A, l.local);
+  l.local_residual = s.max_residual;
   report.llg_steps += s.llg_steps;
   report.newton_steps += s.newton_steps;
   l.backend.responsive_field(l.model, l.state, l.H_resp);
@@ -198,7 +207,8 @@ std::vector<Vec3> apply_map(OuterLoop& l, const std::vector<double>& x, RelaxRep
 }
 
 // Residual: change of each cell's applied field against its field scale.
-// Sets f = G(x) - x (flattened) and returns the largest relative change.
+// Sets f = G(x) - x (flattened) and returns the largest relative change;
+// NaN when any cell's change or the local relaxation was not finite.
 double iterate_residual(const OuterLoop& l, const std::vector<Vec3>& G, std::vector<double>& f) {
   double worst = 0.0;
   const double fl = field_scale_floor(l, G);
@@ -206,8 +216,9 @@ double iterate_residual(const OuterLoop& l, const std::vector<Vec3>& G, std::vec
     const int c = l.cells[i];
     const Vec3 d = G[i] - l.H_A[c];
     for (int a = 0; a < 3; ++a) f[3 * i + a] = d[a];
-    worst = std::max(worst, norm(d) / (cell_field_scale(l.model, l.state, c, G[i]) + fl));
+    worst = max_keeping_nan(worst, norm(d) / (cell_field_scale(l.model, l.state, c, G[i]) + fl));
   }
+  if (!std::isfinite(l.local_residual)) worst = std::numeric_limits<double>::quiet_NaN();
   return worst;
 }
 
@@ -294,6 +305,7 @@ RelaxReport relax_two_level(const MagneticModel& model, MagneticState& state, co
     report.residual = worst;
     report.residual_history.push_back(worst);
     if (o.progress) o.progress(report);
+    if (!std::isfinite(worst)) break;  // non-finite cells: not converged, and no iteration can mend them
     if (worst <= o.tolerance) {
       report.converged = true;
       for (size_t i = 0; i < cells.size(); ++i) l.H_A[cells[i]] = G[i];
