@@ -36,6 +36,21 @@ RenderColor rainbow(double t) {
   return hsv(270.0 * (1.0 - t), 0.9, 0.92);
 }
 
+RenderColor force_color(double t) {
+  if (!(t >= 0.0)) t = 0.0;  // also catches NaN
+  if (t > 1.0) t = 1.0;
+  constexpr RenderColor stops[3] = {{0.05f, 0.45f, 0.40f},   // weakest: dark teal
+                                    {0.35f, 0.70f, 0.28f},   // green
+                                    {0.98f, 0.86f, 0.10f}};  // strongest: yellow
+  const double u = 2.0 * t;
+  const int i = std::min(1, static_cast<int>(u));
+  const auto f = static_cast<float>(u - i);
+  RenderColor c{};
+  for (std::size_t k = 0; k < 3; ++k)
+    c[k] = stops[i][k] + f * (stops[i + 1][k] - stops[i][k]);
+  return c;
+}
+
 double hue_degrees(const RenderColor& c) {
   const double r = c[0], g = c[1], b = c[2];
   const double mx = std::max({r, g, b}), mn = std::min({r, g, b});

@@ -1,4 +1,4 @@
-// Colours for odemag renderings: a rainbow map for force magnitudes and a
+// Colours for odemag renderings: the force colour map, a rainbow map, and a
 // small palette for the usual bodies.
 #pragma once
 
@@ -13,6 +13,14 @@ using RenderColor = std::array<float, 3>;  // RGB, each 0..1
 // (strongest); the hue falls monotonically from 270 to 0 degrees. t is clamped
 // to [0, 1]; NaN maps to 0.
 RenderColor rainbow(double t);
+
+// Force colour map (scene render.force_colors; the legend's colour bar):
+// t = 0 (weakest) dark teal through green to t = 1 (strongest) yellow,
+// piecewise linear in RGB with brightness rising with t. Its hues (about 175
+// down to 50 degrees) stay clear of the pole colours (north red, about 4
+// degrees; south blue, about 222 degrees), so a strongly pulled body is never
+// mistaken for a north pole. t is clamped to [0, 1]; NaN maps to 0.
+RenderColor force_color(double t);
 
 // Hue in degrees [0, 360) of an RGB colour (0 for greys); the inverse of the
 // hue part of rainbow(), used to check or sort colours.

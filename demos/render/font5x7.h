@@ -1,5 +1,5 @@
-// Built-in 5x7 bitmap font for printable ASCII (0x20..0x7e), drawn by hand
-// for odemag's frame captions.
+// Built-in 5x7 bitmap font for printable ASCII (0x20..0x7e), drawn by hand:
+// frame captions in builds without FreeType (demos/render/text.h).
 #pragma once
 
 #include <array>

@@ -6,11 +6,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <functional>
+#include <iterator>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
 
 #include "demos/render/font5x7.h"
+#include "demos/render/text.h"
 
 namespace odemag {
 
@@ -274,6 +278,8 @@ struct ViewInfo {
 
 void set_color(const RenderColor& c, float alpha = 1.0f) { glColor4f(c[0], c[1], c[2], alpha); }
 
+bool translucent(const RenderPrimitive& p) { return p.opacity < 1.0f; }
+
 std::uint8_t to_byte(float v) {
   return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
 }
@@ -291,6 +297,7 @@ struct OffscreenRenderer::Impl {
   // (finest first); the cube needs only one.
   std::array<GLuint, 3> sphere_lists{}, cylinder_lists{};
   GLuint cube_list = 0;
+  std::unique_ptr<TextFont> font;  // captions and legend
 
   ~Impl() {
     if (context != nullptr) OSMesaDestroyContext(context);  // frees its display lists
@@ -324,10 +331,13 @@ struct OffscreenRenderer::Impl {
 
   void draw_ground(const RenderFrame& scene);
   void draw_shadows(const RenderFrame& scene, const ViewInfo& view, const Vec3& light);
-  void draw_primitive(const RenderPrimitive& p, const ViewInfo& view);
+  void draw_primitive(const RenderPrimitive& p, const ViewInfo& view, float alpha = 1.0f);
+  void draw_translucent(const RenderFrame& scene, const ViewInfo& view);
   void draw_lines(const RenderFrame& scene);
   void downsample(std::vector<std::uint8_t>& rgb) const;
+  void shade_band(const RenderFrame& scene, std::vector<std::uint8_t>& rgb, int y0, int y1) const;
   void draw_caption(const RenderFrame& scene, std::vector<std::uint8_t>& rgb) const;
+  void draw_legend(const RenderFrame& scene, std::vector<std::uint8_t>& rgb) const;
 };
 
 OffscreenRenderer::OffscreenRenderer(int width, int height, int supersample)
@@ -366,6 +376,7 @@ OffscreenRenderer::OffscreenRenderer(int width, int height, int supersample)
     throw std::runtime_error("OffscreenRenderer: OSMesa context has " + std::to_string(depth_bits) +
                              " depth bits (need at least 16)");
   m.compile_meshes();
+  m.font = std::make_unique<TextFont>(caption_pixel_size(height));
 }
 
 OffscreenRenderer::~OffscreenRenderer() = default;
@@ -422,7 +433,7 @@ void OffscreenRenderer::Impl::draw_shadows(const RenderFrame& scene, const ViewI
   glMatrixMode(GL_MODELVIEW);
   const Mat4 shadow = planar_shadow(light, scene.ground_height);
   for (const RenderPrimitive& p : scene.primitives) {
-    if (!p.cast_shadow || !is_finite(p.position) || !is_finite(p.size)) continue;
+    if (!p.cast_shadow || translucent(p) || !is_finite(p.position) || !is_finite(p.size)) continue;
     // Bodies wholly below the ground cast nothing. (GL clip planes act after
     // the projection, where every vertex lies in the ground plane, so parts
     // of a body sunk into the ground are not cut off; they are rare.)
@@ -439,7 +450,7 @@ void OffscreenRenderer::Impl::draw_shadows(const RenderFrame& scene, const ViewI
   glDisable(GL_STENCIL_TEST);
 }
 
-void OffscreenRenderer::Impl::draw_primitive(const RenderPrimitive& p, const ViewInfo& view) {
+void OffscreenRenderer::Impl::draw_primitive(const RenderPrimitive& p, const ViewInfo& view, float alpha) {
   if (!is_finite(p.position) || !is_finite(p.size)) return;
   const double sx = p.size.x, sy = p.size.y, sz = p.size.z;
   glMatrixMode(GL_MODELVIEW);
@@ -451,7 +462,7 @@ void OffscreenRenderer::Impl::draw_primitive(const RenderPrimitive& p, const Vie
   const Vec3 axis = normalized(p.pole_axis);
   if (squared_norm(axis) == 0.0 || !is_finite(axis)) {
     glScaled(sx, sy, sz);
-    set_color(p.color);
+    set_color(p.color, alpha);
     glCallList(mesh);
     return;
   }
@@ -464,14 +475,42 @@ void OffscreenRenderer::Impl::draw_primitive(const RenderPrimitive& p, const Vie
   glClipPlane(GL_CLIP_PLANE0, north);
   glPushMatrix();
   glScaled(sx, sy, sz);
-  set_color(p.north_color);
+  set_color(p.north_color, alpha);
   glCallList(mesh);
   glPopMatrix();
   glClipPlane(GL_CLIP_PLANE0, south);
   glScaled(sx, sy, sz);
-  set_color(p.south_color);
+  set_color(p.south_color, alpha);
   glCallList(mesh);
   glDisable(GL_CLIP_PLANE0);
+}
+
+void OffscreenRenderer::Impl::draw_translucent(const RenderFrame& scene, const ViewInfo& view) {
+  std::vector<std::pair<double, const RenderPrimitive*>> order;
+  for (const RenderPrimitive& p : scene.primitives)
+    if (translucent(p) && p.opacity > 0.0f && is_finite(p.position))
+      order.emplace_back(norm(p.position - view.eye), &p);
+  if (order.empty()) return;
+  // Farthest first; each body's far side, then its near side. Depth is tested
+  // (opaque solids and lines hide them) but not written.
+  std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_CULL_FACE);
+  for (const auto& entry : order) {
+    const RenderPrimitive* p = entry.second;
+    // Two surfaces per body: each gets alpha a with (1 - a)^2 = 1 - opacity,
+    // so that looking through the body dims what is behind by its opacity.
+    const float alpha = 1.0f - std::sqrt(1.0f - std::clamp(p->opacity, 0.0f, 1.0f));
+    glCullFace(GL_FRONT);
+    draw_primitive(*p, view, alpha);
+    glCullFace(GL_BACK);
+    draw_primitive(*p, view, alpha);
+  }
+  glFrontFace(GL_CCW);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
 }
 
 void OffscreenRenderer::Impl::draw_lines(const RenderFrame& scene) {
@@ -517,29 +556,165 @@ void OffscreenRenderer::Impl::downsample(std::vector<std::uint8_t>& rgb) const {
   }
 }
 
+void OffscreenRenderer::Impl::shade_band(const RenderFrame& scene, std::vector<std::uint8_t>& rgb, int y0,
+                                         int y1) const {
+  // A translucent panel in the background colour keeps text readable over
+  // the scene.
+  for (int y = std::max(0, y0); y < std::min(height, y1); ++y) {
+    std::uint8_t* px = rgb.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width) * 3;
+    for (int x = 0; x < width; ++x, px += 3)
+      for (int c = 0; c < 3; ++c)
+        px[c] = to_byte(0.25f * static_cast<float>(px[c]) / 255.0f + 0.75f * scene.background[static_cast<std::size_t>(c)]);
+  }
+}
+
+namespace {
+
+// Margins of the caption and legend bands for a font.
+int band_margin(const TextFont& f) { return std::max(3, f.pixel_size() / 2); }
+int band_pad(const TextFont& f) { return std::max(2, f.pixel_size() / 4); }
+
+void fill_rect(std::vector<std::uint8_t>& rgb, int width, int height, int x0, int y0, int x1, int y1,
+               const RenderColor& color) {
+  const std::uint8_t c[3] = {to_byte(color[0]), to_byte(color[1]), to_byte(color[2])};
+  for (int y = std::max(0, y0); y < std::min(height, y1); ++y)
+    for (int x = std::max(0, x0); x < std::min(width, x1); ++x) {
+      std::uint8_t* px = rgb.data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 3;
+      px[0] = c[0], px[1] = c[1], px[2] = c[2];
+    }
+}
+
+// A value with an SI prefix and the unit, three significant digits: "12.5 mN".
+std::string si_value(double v, const std::string& unit, bool micro_sign) {
+  if (v == 0.0 || !std::isfinite(v)) return (std::isfinite(v) ? "0 " : "? ") + unit;
+  struct Prefix {
+    double factor;
+    const char* name;
+  };
+  const Prefix prefixes[] = {{1e9, "G"}, {1e6, "M"}, {1e3, "k"}, {1.0, ""}, {1e-3, "m"},
+                             {1e-6, micro_sign ? "\xc2\xb5" : "u"}, {1e-9, "n"}, {1e-12, "p"}};
+  const double a = std::fabs(v);
+  const Prefix* chosen = &prefixes[std::size(prefixes) - 1];
+  for (const Prefix& p : prefixes)
+    if (a >= p.factor * 0.9995) {
+      chosen = &p;
+      break;
+    }
+  char text[64];
+  std::snprintf(text, sizeof text, "%.3g %s", v / chosen->factor, chosen->name);
+  return text + unit;
+}
+
+}  // namespace
+
 void OffscreenRenderer::Impl::draw_caption(const RenderFrame& scene, std::vector<std::uint8_t>& rgb) const {
   if (scene.text.empty()) return;
-  const int scale = std::max(1, height / 240);
-  const int margin = 4 * scale, pad = 2 * scale;
-  std::size_t longest = 0;
-  for (const std::string& line : scene.text) longest = std::max(longest, line.size());
-  if (longest == 0) return;
-  // A translucent panel in the background colour keeps the text readable
-  // over the scene.
-  const int panel_w = static_cast<int>(longest) * font5x7::kAdvance * scale - scale + 2 * pad;
-  const int panel_h = static_cast<int>(scene.text.size()) * font5x7::kLineHeight * scale - 2 * scale + 2 * pad;
-  const int x0 = margin - pad, y0 = margin - pad;
-  for (int y = std::max(0, y0); y < std::min(height, y0 + panel_h); ++y) {
-    for (int x = std::max(0, x0); x < std::min(width, x0 + panel_w); ++x) {
-      std::uint8_t* px = rgb.data() + (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)) * 3;
-      for (int c = 0; c < 3; ++c)
-        px[c] = to_byte(0.3f * static_cast<float>(px[c]) / 255.0f + 0.7f * scene.background[static_cast<std::size_t>(c)]);
+  const TextFont& f = *font;
+  const int margin = band_margin(f), pad = band_pad(f);
+  std::vector<std::string> lines;
+  for (const std::string& paragraph : scene.text)
+    for (std::string& line : f.wrap(paragraph, width - 2 * margin)) lines.push_back(std::move(line));
+  if (lines.empty()) return;
+  const int band = 2 * pad + static_cast<int>(lines.size()) * f.line_height();
+  shade_band(scene, rgb, 0, band);
+  int baseline = pad + f.ascent();
+  for (const std::string& line : lines) {
+    f.draw(rgb, width, height, margin, baseline, line, scene.text_color);
+    baseline += f.line_height();
+  }
+}
+
+void OffscreenRenderer::Impl::draw_legend(const RenderFrame& scene, std::vector<std::uint8_t>& rgb) const {
+  const RenderLegend& legend = scene.legend;
+  if (!legend.any()) return;
+  const TextFont& f = *font;
+  const int margin = band_margin(f), pad = band_pad(f), em = f.pixel_size();
+  const int swatch = std::max(4, f.ascent() * 3 / 4);
+  const int line = std::max(1, em / 9);  // stroke of the scale bar
+  const RenderColor ink = scene.text_color;
+
+  // The items, each a width and a painter taking (x, baseline).
+  struct Item {
+    int width;
+    std::function<void(int, int)> paint;
+  };
+  std::vector<Item> items;
+  auto swatch_item = [&](const std::string& name, const RenderColor& color) {
+    const int text_x = swatch + em / 3;
+    return Item{text_x + f.width_of(name), [&, name, color, text_x](int x, int baseline) {
+                  fill_rect(rgb, width, height, x, baseline - swatch, x + swatch, baseline, color);
+                  f.draw(rgb, width, height, x + text_x, baseline, name, ink);
+                }};
+  };
+  if (legend.poles) {
+    items.push_back(swatch_item("north", legend.north));
+    items.push_back(swatch_item("south", legend.south));
+  }
+  if (!legend.colorbar.empty()) {
+    const bool micro = f.freetype();
+    const std::string low = si_value(legend.colorbar_low, legend.colorbar_unit, micro);
+    const std::string high = si_value(legend.colorbar_high, legend.colorbar_unit, micro);
+    const std::string head = legend.colorbar_label + " " + (legend.colorbar_low == 0.0 ? "0" : low);
+    const int bar = 5 * em, gap = em / 3;
+    const int w_head = f.width_of(head), w_high = f.width_of(high);
+    items.push_back(Item{w_head + gap + bar + gap + w_high, [&, head, high, bar, gap, w_head](int x, int baseline) {
+                           f.draw(rgb, width, height, x, baseline, head, ink);
+                           const int x0 = x + w_head + gap;
+                           const std::size_t n = legend.colorbar.size();
+                           for (int i = 0; i < bar; ++i) {
+                             // Sample i of the bar, linear between the given colours.
+                             const double u = n == 1 ? 0.0 : (i + 0.5) / bar * static_cast<double>(n - 1);
+                             const std::size_t k = std::min(n - 1, static_cast<std::size_t>(u));
+                             const std::size_t k1 = std::min(n - 1, k + 1);
+                             const auto t = static_cast<float>(u - static_cast<double>(k));
+                             RenderColor c{};
+                             for (std::size_t j = 0; j < 3; ++j)
+                               c[j] = legend.colorbar[k][j] + t * (legend.colorbar[k1][j] - legend.colorbar[k][j]);
+                             fill_rect(rgb, width, height, x0 + i, baseline - swatch, x0 + i + 1, baseline, c);
+                           }
+                           f.draw(rgb, width, height, x0 + bar + gap, baseline, high, ink);
+                         }});
+  }
+  if (legend.scale_bar) {
+    const ScaleBar sb = scale_bar_for(scene.camera, height, std::max(0.2 * width, 3.0 * em));
+    const int n = static_cast<int>(std::lround(sb.pixels));
+    if (n >= 2) {
+      const int gap = em / 3;
+      items.push_back(Item{n + gap + f.width_of(sb.label), [&, sb, n, gap](int x, int baseline) {
+                             // A bar of n pixels with end ticks, centred on the x-height.
+                             const int mid = baseline - f.ascent() / 3;
+                             const int tick = std::max(2, f.ascent() / 3);
+                             fill_rect(rgb, width, height, x, mid - line / 2, x + n, mid - line / 2 + line, ink);
+                             fill_rect(rgb, width, height, x, mid - tick, x + line, mid + tick, ink);
+                             fill_rect(rgb, width, height, x + n - line, mid - tick, x + n, mid + tick, ink);
+                             f.draw(rgb, width, height, x + n + gap, baseline, sb.label, ink);
+                           }});
     }
   }
-  int y = margin;
-  for (const std::string& line : scene.text) {
-    draw_text_rgb(rgb, width, height, margin, y, line, scene.text_color, scale);
-    y += font5x7::kLineHeight * scale;
+  if (items.empty()) return;
+  // Rows, filled left to right.
+  const int spacing = em, room = width - 2 * margin;
+  std::vector<std::vector<std::size_t>> rows(1);
+  int used = 0;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const int need = (rows.back().empty() ? 0 : spacing) + items[i].width;
+    if (!rows.back().empty() && used + need > room) {
+      rows.emplace_back();
+      used = 0;
+    }
+    used += rows.back().empty() ? items[i].width : spacing + items[i].width;
+    rows.back().push_back(i);
+  }
+  const int band = 2 * pad + static_cast<int>(rows.size()) * f.line_height();
+  shade_band(scene, rgb, height - band, height);
+  int baseline = height - band + pad + f.ascent();
+  for (const auto& row : rows) {
+    int x = margin;
+    for (std::size_t i : row) {
+      items[i].paint(x, baseline);
+      x += items[i].width + spacing;
+    }
+    baseline += f.line_height();
   }
 }
 
@@ -665,7 +840,8 @@ std::vector<std::uint8_t> OffscreenRenderer::render(const RenderFrame& scene) {
   const GLfloat material_specular[4] = {0.35f, 0.35f, 0.35f, 1.0f};
   glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, material_specular);
   glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, 40.0f);
-  for (const RenderPrimitive& p : scene.primitives) m.draw_primitive(p, view_info);
+  for (const RenderPrimitive& p : scene.primitives)
+    if (!translucent(p)) m.draw_primitive(p, view_info);
   glFrontFace(GL_CCW);
   glDisable(GL_COLOR_MATERIAL);
   glDisable(GL_NORMALIZE);
@@ -674,13 +850,52 @@ std::vector<std::uint8_t> OffscreenRenderer::render(const RenderFrame& scene) {
   glMatrixMode(GL_MODELVIEW);
   glLoadMatrixd(view.data());
   m.draw_lines(scene);
+
+  // Translucent solids, lit, over everything behind them.
+  glEnable(GL_LIGHTING);
+  glEnable(GL_NORMALIZE);
+  glEnable(GL_COLOR_MATERIAL);
+  m.draw_translucent(scene, view_info);
+  glDisable(GL_COLOR_MATERIAL);
+  glDisable(GL_NORMALIZE);
+  glDisable(GL_LIGHTING);
   glDisableClientState(GL_VERTEX_ARRAY);
   glFinish();
 
   std::vector<std::uint8_t> rgb;
   m.downsample(rgb);
   m.draw_caption(scene, rgb);
+  m.draw_legend(scene, rgb);
   return rgb;
+}
+
+// ---------------------------------------------------------------- legend
+
+int caption_pixel_size(int height) { return std::max(9, static_cast<int>(std::lround(height / 30.0))); }
+
+ScaleBar scale_bar_for(const RenderCamera& camera, int height, double max_pixels) {
+  ScaleBar sb;
+  const double d = norm(camera.target - camera.position);
+  const double fov = std::clamp(camera.fov_degrees, 1.0, 170.0);
+  const double per_metre = height / (2.0 * d * std::tan(0.5 * fov * std::numbers::pi / 180.0));
+  if (!(per_metre > 0.0) || !std::isfinite(per_metre) || !(max_pixels > 0.0)) return sb;
+  const double longest = max_pixels / per_metre;
+  const double decade = std::pow(10.0, std::floor(std::log10(longest)));
+  const double mantissa = longest / decade * (1.0 + 1e-9);
+  const double step = mantissa >= 5.0 ? 5.0 : (mantissa >= 2.0 ? 2.0 : 1.0);
+  sb.metres = step * decade;
+  sb.pixels = sb.metres * per_metre;
+  char text[48];
+  if (sb.metres >= 1000.0)
+    std::snprintf(text, sizeof text, "%g km", sb.metres / 1000.0);
+  else if (sb.metres >= 1.0)
+    std::snprintf(text, sizeof text, "%g m", sb.metres);
+  else if (sb.metres >= 0.01)
+    std::snprintf(text, sizeof text, "%g cm", sb.metres * 100.0);
+  else
+    std::snprintf(text, sizeof text, "%g mm", sb.metres * 1000.0);
+  sb.label = text;
+  return sb;
 }
 
 // ---------------------------------------------------------------- text

@@ -44,6 +44,11 @@ struct RenderPrimitive {
   RenderColor north_color{0.85f, 0.15f, 0.12f};
   RenderColor south_color{0.15f, 0.30f, 0.85f};
   bool cast_shadow = true;  // onto the ground plane
+  // 1: opaque. Less: translucent (e.g. glass), alpha-blended over what lies
+  // behind it (seen through the body, what is behind keeps 1 - opacity of
+  // its colour); drawn after the opaque solids and the lines, farthest
+  // first, without writing depth, and casting no shadow.
+  float opacity = 1.0f;
 
   static RenderPrimitive sphere(const Vec3& centre, double radius, const RenderColor& color);
   static RenderPrimitive box(const Vec3& centre, const Vec3& edges, const Mat3& rotation,
@@ -60,6 +65,26 @@ struct RenderLine {
   float width = 1.5f;
 };
 
+// A legend band across the bottom of the image (drawn when any part is on):
+// pole colour swatches, a colour bar, a scale bar. Items that do not fit on a
+// row go to another row.
+struct RenderLegend {
+  bool poles = false;  // "north" and "south" swatches in these colours
+  RenderColor north = palette::north;
+  RenderColor south = palette::south;
+  // Colour bar: samples of the colour map from the low end of the range to
+  // the high end (empty: no bar), labelled "<label> <low> .. <high> <unit>".
+  std::vector<RenderColor> colorbar;
+  double colorbar_low = 0.0, colorbar_high = 0.0;
+  std::string colorbar_label = "|F|";
+  std::string colorbar_unit = "N";  // SI unit; values get a prefix (m, µ, ...)
+  // Scale bar: a length of 1, 2 or 5 x 10^k m as it appears at the distance
+  // of the camera target (scale_bar_for).
+  bool scale_bar = false;
+
+  bool any() const { return poles || !colorbar.empty() || scale_bar; }
+};
+
 struct RenderFrame {
   RenderCamera camera;
   RenderColor background{0.93f, 0.94f, 0.96f};
@@ -73,11 +98,29 @@ struct RenderFrame {
   bool shadows = true;  // hard shadows of the primitives on the ground plane
   std::vector<RenderPrimitive> primitives;
   std::vector<RenderLine> lines;  // e.g. magnetic field lines
-  // Caption lines drawn top-left over the finished image with a built-in 5x7
-  // bitmap font (printable ASCII; others show as '?'), e.g. "t = 0.40 s".
+  // Caption paragraphs, e.g. "t = 0.40 s" and the scene title, each wrapped
+  // to the image width (demos/render/text.h: DejaVu Sans with FreeType, or
+  // the built-in 5x7 font), in a band across the top of the finished image
+  // on a translucent panel of the background colour.
   std::vector<std::string> text;
   RenderColor text_color{0.10f, 0.10f, 0.12f};
+  RenderLegend legend;
 };
+
+// Pixel size of the caption and legend font for an image `height` pixels
+// tall: about height / 30, at least 9.
+int caption_pixel_size(int height);
+
+// The scale bar for a camera and an image `height` pixels tall: the longest
+// length L = {1, 2, 5} x 10^k m that spans at most max_pixels pixels at the
+// distance d of the camera target, where one metre spans
+// height / (2 d tan(fov / 2)) pixels; and its label ("2 cm", "5 mm", "1 m").
+struct ScaleBar {
+  double metres = 0.0;
+  double pixels = 0.0;
+  std::string label;
+};
+ScaleBar scale_bar_for(const RenderCamera& camera, int height, double max_pixels);
 
 class OffscreenRenderer {
  public:
@@ -107,7 +150,7 @@ class OffscreenRenderer {
 };
 
 // Draws `text` into a tightly packed RGB8 image (top row first) with the
-// built-in 5x7 font, each font pixel a scale x scale block, the glyph cell's
+// built-in 5x7 font (TextFont's fallback; captions use TextFont), each font pixel a scale x scale block, the glyph cell's
 // top-left corner at (x, y); one line, no wrapping, clipped to the image.
 // Returns the x just after the last glyph.
 int draw_text_rgb(std::vector<std::uint8_t>& rgb, int width, int height, int x, int y,

@@ -1,6 +1,7 @@
 #include "demos/view/scene_view.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -34,17 +35,64 @@ double scene_size(const SceneDescription& scene) {
   return std::max(1e-3, norm(scene.camera.position - scene.camera.target));
 }
 
-bool inside_a_magnet(const MagneticModel& model, const MagneticState& state, const Vec3& p) {
-  for (int b = 0; b < model.body_count(); ++b) {
-    const MagneticBody& body = model.body(b);
-    if (body.inert() || body.kind == CellKind::soft || !state.active[b]) continue;
-    const Vec3 local = state.pose[b].rotation.transpose_times(p - state.pose[b].position);
-    if (shape_contains(body.shape, local)) return true;
+bool inside_a_source(const MagneticModel& model, const MagneticState& state, const std::vector<FieldSource>& sources,
+                     const Vec3& p) {
+  for (const FieldSource& s : sources) {
+    const Vec3 local = state.pose[s.body].rotation.transpose_times(p - state.pose[s.body].position);
+    if (shape_contains(model.body(s.body).shape, local)) return true;
   }
   return false;
 }
 
+// Inert bodies of a material named like glass ("glass", "Glass_tube") are
+// drawn translucent, so that what they hold stays visible.
+bool glass_material(const std::string& material) {
+  std::string lower = material;
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower.find("glass") != std::string::npos;
+}
+
 }  // namespace
+
+std::vector<FieldSource> field_sources(const MagneticModel& model, const MagneticState& state) {
+  std::vector<FieldSource> all;
+  double strongest = 0.0;
+  for (int b = 0; b < model.body_count(); ++b) {
+    const MagneticBody& body = model.body(b);
+    if (body.inert() || !state.active[b]) continue;
+    FieldSource s;
+    s.body = b;
+    const Vec3 moment = body_moment(model, state, b);
+    s.moment = norm(moment);
+    if (body.kind != CellKind::soft) {
+      const Vec3 m = state.magnetization_scale[b] * body.remanence;
+      if (norm(m) == 0.0) continue;
+      s.kind = FieldSource::Kind::permanent;
+      s.axis = state.pose[b].rotation * normalized(m);
+      // Before the cells are placed the state's moment is zero.
+      if (s.moment == 0.0) s.moment = norm(m) * shape_volume(body.shape);
+    } else {
+      if (!(s.moment > 0.0) || !std::isfinite(s.moment)) continue;
+      const bool coil_on = norm(state.magnetization_scale[b] * body.coil_field) > 0.0;
+      s.kind = coil_on ? FieldSource::Kind::electromagnet : FieldSource::Kind::induced;
+      s.axis = moment / s.moment;
+    }
+    if (!is_finite(s.axis) || squared_norm(s.axis) == 0.0) continue;
+    strongest = std::max(strongest, s.moment);
+    all.push_back(s);
+  }
+  std::vector<FieldSource> sources;
+  for (const FieldSource& s : all)
+    if (s.kind != FieldSource::Kind::induced || s.moment >= kInducedSourceFraction * strongest)
+      sources.push_back(s);
+  // Magnets and electromagnets first, then by moment.
+  std::stable_sort(sources.begin(), sources.end(), [](const FieldSource& a, const FieldSource& b) {
+    const bool ai = a.kind == FieldSource::Kind::induced, bi = b.kind == FieldSource::Kind::induced;
+    if (ai != bi) return bi;
+    return a.moment > b.moment;
+  });
+  return sources;
+}
 
 ViewOptions view_options(const SceneDescription& scene) {
   ViewOptions o;
@@ -56,28 +104,35 @@ ViewOptions view_options(const SceneDescription& scene) {
 
 std::vector<RenderLine> trace_field_lines(const MagneticModel& model, const MagneticState& state,
                                           MagneticBackend& backend, int count, double size) {
-  // Seeds: rings on the north faces of the magnetized permanent magnets.
+  // Seeds: rings on the north faces of the magnetized bodies: every magnet
+  // and electromagnet, and induced bodies, strongest first, while they get
+  // four lines each.
+  const std::vector<FieldSource> all_sources = field_sources(model, state);
+  if (all_sources.empty() || count <= 0) return {};
+  std::vector<FieldSource> sources;
+  const auto most = static_cast<std::size_t>(std::max(1, count / 4));
+  for (const FieldSource& s : all_sources)
+    if (s.kind != FieldSource::Kind::induced || sources.size() < most) sources.push_back(s);
+  const int per_magnet = std::max(1, count / static_cast<int>(sources.size()));
   std::vector<Vec3> heads;
-  std::vector<int> magnets;
-  for (int b = 0; b < model.body_count(); ++b) {
+  for (const FieldSource& source : sources) {
+    const int b = source.body;
     const MagneticBody& body = model.body(b);
-    if (body.inert() || body.kind == CellKind::soft || !state.active[b]) continue;
-    if (norm(state.magnetization_scale[b] * body.remanence) == 0.0) continue;
-    magnets.push_back(b);
-  }
-  if (magnets.empty() || count <= 0) return {};
-  const int per_magnet = std::max(1, count / static_cast<int>(magnets.size()));
-  for (int b : magnets) {
-    const MagneticBody& body = model.body(b);
-    const Vec3 axis = normalized(state.magnetization_scale[b] * body.remanence);  // body frame
+    const Vec3 axis = normalized(state.pose[b].rotation.transpose_times(source.axis));  // body frame
     const Vec3 half = shape_half_extents(body.shape);
-    const double reach = std::abs(axis.x) * half.x + std::abs(axis.y) * half.y + std::abs(axis.z) * half.z;
-    Vec3 u = normalized(cross(axis, std::abs(axis.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+    // How far the body's bounding box reaches along a body-frame direction.
+    auto reach_along = [&](const Vec3& d) {
+      return std::abs(d.x) * half.x + std::abs(d.y) * half.y + std::abs(d.z) * half.z;
+    };
+    const double reach = reach_along(axis);
+    const Vec3 u = normalized(cross(axis, std::abs(axis.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
     const Vec3 v = cross(axis, u);
-    const double lateral = 0.6 * std::min({half.x, half.y, half.z});
+    // A ring over the north face, 0.6 of the way out across it (a flat core
+    // magnetized through its thickness gets a wide one).
+    const double lateral_u = 0.6 * reach_along(u), lateral_v = 0.6 * reach_along(v);
     for (int k = 0; k < per_magnet; ++k) {
       const double phi = 2.0 * kPi * (k + 0.5) / per_magnet;
-      const Vec3 local = (reach * 1.02) * axis + lateral * (std::cos(phi) * u + std::sin(phi) * v);
+      const Vec3 local = (reach * 1.02) * axis + (lateral_u * std::cos(phi)) * u + (lateral_v * std::sin(phi)) * v;
       heads.push_back(state.pose[b].position + state.pose[b].rotation * local);
     }
   }
@@ -112,7 +167,7 @@ std::vector<RenderLine> trace_field_lines(const MagneticModel& model, const Magn
       heads[i] = next;
       lines[i].points.push_back(next);
       const bool far = norm(next - lines[i].points.front()) > 3.0 * size;
-      if (far || (step > 3 && inside_a_magnet(model, state, next))) live[i] = 0;
+      if (far || (step > 3 && inside_a_source(model, state, all_sources, next))) live[i] = 0;
     }
   }
   return lines;
@@ -154,8 +209,24 @@ RenderFrame render_scene_of(const Simulation& sim, const ViewOptions& options, M
     if (magnet && norm(magnetics.magnetization_scale(b) * body.remanence) > 0.0)
       p.pole_axis = normalized(body.remanence);  // two colours: north along +M
     if (options.force_colors && !body.inert() && !magnet && strongest > 0.0)
-      p.color = rainbow(norm(magnetics.force(b)) / strongest);
+      p.color = force_color(norm(magnetics.force(b)) / strongest);
+    if (body.inert() && glass_material(d.material)) p.opacity = kGlassOpacity;
+    if (squared_norm(p.pole_axis) > 0.0) {
+      view.legend.poles = true;
+      view.legend.north = p.north_color;
+      view.legend.south = p.south_color;
+    }
     view.primitives.push_back(p);
+  }
+  if (options.legend) {
+    view.legend.scale_bar = true;
+    if (options.force_colors && strongest > 0.0) {
+      for (int i = 0; i <= 8; ++i) view.legend.colorbar.push_back(force_color(i / 8.0));
+      view.legend.colorbar_low = 0.0;
+      view.legend.colorbar_high = strongest;
+    }
+  } else {
+    view.legend.poles = false;
   }
   if (options.field_lines && field_backend)
     view.lines = trace_field_lines(model, magnetics.state(), *field_backend, options.field_line_count,
@@ -164,11 +235,8 @@ RenderFrame render_scene_of(const Simulation& sim, const ViewOptions& options, M
     char t[64];
     std::snprintf(t, sizeof t, "t = %.2f s", sim.time());
     view.text.push_back(t);
-    // The title up to its first colon ("Ball chain (paper Fig. 12)").
-    std::string title = scene.title.empty() ? std::filesystem::path(scene.file).stem().string() : scene.title;
-    title = title.substr(0, title.find(':'));
-    if (title.size() > 70) title = title.substr(0, 67) + "...";
-    view.text.push_back(title);
+    // The whole title; the renderer wraps it to the image width.
+    view.text.push_back(scene.title.empty() ? std::filesystem::path(scene.file).stem().string() : scene.title);
   }
   return view;
 }

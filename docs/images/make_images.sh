@@ -1,12 +1,21 @@
 #!/usr/bin/env bash
 # Renders the representative frames of each paper scene shown in README.md and
 # docs/scenes.md: docs/images/<scene>.png, three or four frames side by side
-# (320 x 240 each, captions from the renderer). Needs a build with the renderer
-# (bash scripts/build.sh) and ImageMagick's `montage`. Usage:
+# (400 x 300 each, with the renderer's caption band and legend: docs/rendering.md).
+# Needs a build with the renderer (bash scripts/build.sh; the odemag and
+# odemag_png_row targets); no ImageMagick. The crane is shown with 24 field
+# lines (a copy of the scene with render.field_lines set; the scene file is
+# unchanged). Usage:
 #   bash docs/images/make_images.sh [SCENE ...]     (default: all scenes)
+# ODEMAG_BUILD=DIR uses another build directory (default: build).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-odemag=build/bin/odemag
+build=${ODEMAG_BUILD:-build}
+odemag=$build/bin/odemag
+row=$build/bin/odemag_png_row
+for program in "$odemag" "$row"; do
+  [ -x "$program" ] || { echo "make_images.sh: $program not found: build it first" >&2; exit 1; }
+done
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # scene: times (s) of the frames to show
@@ -21,17 +30,32 @@ declare -A times=(
   [nail_no_anisotropy]="0.8 2.4 5.0"
   [crane]="1.2 2.9 3.9 5.0"
 )
+# scenes drawn with field lines although the scene file has them off: how many
+declare -A field_lines=([crane]=24)
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(ball_chain ball_chain_no_induction wood_plate iron_plate thin_iron_plate
                                    thick_iron_plate nail_and_balls nail_no_anisotropy crane)
 rate=10
 for s in "${scenes[@]}"; do
   echo "== $s"
-  "$odemag" run "demos/scenes/$s.json" --out "$work/$s" --frame-rate $rate --width 320 --height 240 \
+  scene=demos/scenes/$s.json
+  if [ -n "${field_lines[$s]:-}" ]; then
+    python3 - "$scene" "$work/$s.json" "${field_lines[$s]}" <<'EOF'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+scene.setdefault("render", {}).update(field_lines=True, field_line_count=int(sys.argv[3]))
+json.dump(scene, open(sys.argv[2], "w"), indent=1)
+EOF
+    scene=$work/$s.json
+  fi
+  last=0
+  for t in ${times[$s]}; do last=$t; done
+  "$odemag" run "$scene" --out "$work/$s" --frame-rate $rate --duration "$last" --width 400 --height 300 \
     --quiet yes
   frames=()
   for t in ${times[$s]}; do
     frames+=("$(printf '%s/%s/frame_%05d.png' "$work" "$s" "$(python3 -c "print(round($t * $rate))")")")
   done
-  montage "${frames[@]}" -tile "${#frames[@]}x1" -geometry +2+0 -background white "docs/images/$s.png"
+  "$row" "docs/images/$s.png" "${frames[@]}" --gap 4
+  ls -l "docs/images/$s.png"
 done

@@ -146,7 +146,7 @@ struct CameraSettings {
 struct RenderSettings {
   bool field_lines = false;   // grey field lines traced from the solved field
   int field_line_count = 48;
-  bool force_colors = false;  // bodies coloured by force magnitude (violet..red)
+  bool force_colors = false;  // bodies coloured by force magnitude (teal..yellow, docs/rendering.md)
 };
 
 // A number the scene reports in summary.json: how many bodies whose names start

@@ -1,8 +1,11 @@
 // Tests of the headless renderer: pixels where the geometry is, magnet pole
-// colours, depth testing, lines, captions, the PNG writer and the rainbow map.
+// colours, depth testing, lines, translucency, captions (FreeType text,
+// wrapping), the legend, the PNG writer and the colour maps.
 #include <png.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -15,6 +18,7 @@
 #include "demos/render/colors.h"
 #include "demos/render/png_writer.h"
 #include "demos/render/renderer.h"
+#include "demos/render/text.h"
 
 namespace odemag {
 namespace {
@@ -283,6 +287,215 @@ TEST(RenderText, GlyphShapes) {
   EXPECT_EQ(at(rgb, 12, 9, 2).r, 255);
 }
 
+// A larger blank frame for captions and legends.
+constexpr int kLW = 240, kLH = 180;
+
+RenderFrame blank_scene(int width, int height) {
+  RenderFrame scene = front_scene();
+  scene.camera.width = width;
+  scene.camera.height = height;
+  return scene;
+}
+
+bool dark(const Pixel& p) { return p.r < 128 && p.g < 128 && p.b < 128; }
+
+// Lowest image row (largest y) holding a dark pixel in rows [0, rows), -1 if none.
+int lowest_dark_row(const std::vector<std::uint8_t>& rgb, int width, int rows) {
+  int lowest = -1;
+  for (int y = 0; y < rows; ++y)
+    for (int x = 0; x < width; ++x)
+      if (dark(at(rgb, width, x, y))) lowest = y;
+  return lowest;
+}
+
+TEST(RenderText, CaptionGlyphsHaveDescenders) {
+  if (!text_uses_freetype()) GTEST_SKIP() << "built without FreeType: the 5x7 font has no descenders";
+  OffscreenRenderer renderer(kLW, kLH);
+  RenderFrame scene = blank_scene(kLW, kLH);
+  scene.text = {"xxxx"};
+  const int x_bottom = lowest_dark_row(renderer.render(scene), kLW, kLH / 2);
+  scene.text = {"gygy"};
+  const int g_bottom = lowest_dark_row(renderer.render(scene), kLW, kLH / 2);
+  ASSERT_GT(x_bottom, 0);
+  // 'g' and 'y' reach below the baseline, where 'x' ends.
+  EXPECT_GE(g_bottom, x_bottom + 2) << "x ends at row " << x_bottom << ", g/y at " << g_bottom;
+
+  // The same with TextFont directly: ink below the baseline for "gy", none for "x".
+  const TextFont font(20);
+  ASSERT_TRUE(font.freetype());
+  EXPECT_GE(font.descent(), 3);
+  const int w = 60, h = 40, baseline = 25;
+  std::vector<std::uint8_t> gy(static_cast<std::size_t>(w * h * 3), 255), x(gy);
+  EXPECT_GT(font.draw(gy, w, h, 2, baseline, "gy", {0.0f, 0.0f, 0.0f}), 2 + 10);
+  font.draw(x, w, h, 2, baseline, "x", {0.0f, 0.0f, 0.0f});
+  int below_gy = 0, below_x = 0, partial = 0;
+  for (int yy = 0; yy < h; ++yy)
+    for (int xx = 0; xx < w; ++xx) {
+      const int v = at(gy, w, xx, yy).r;
+      if (v > 0 && v < 255) ++partial;  // anti-aliased edges
+      if (yy > baseline + 1 && v < 128) ++below_gy;
+      if (yy > baseline + 1 && at(x, w, xx, yy).r < 128) ++below_x;
+    }
+  EXPECT_GT(below_gy, 6);
+  EXPECT_EQ(below_x, 0);
+  EXPECT_GT(partial, 10);
+}
+
+TEST(RenderText, LongCaptionWrapsWithinTheWidth) {
+  OffscreenRenderer renderer(kLW, kLH);
+  RenderFrame scene = blank_scene(kLW, kLH);
+  scene.text = {"Wrap"};
+  const int one_line_bottom = lowest_dark_row(renderer.render(scene), kLW, kLH);
+  ASSERT_GT(one_line_bottom, 0);
+  scene.text = {"A long title: it goes on about magnetised steel balls and nails, and about how "
+                "they are lifted, carried and lowered, well past the width of the picture"};
+  const auto rgb = renderer.render(scene);
+  // No ink in the right margin (the background there is untouched)...
+  for (int y = 0; y < kLH; ++y)
+    for (int x = kLW - 3; x < kLW; ++x) expect_background(at(rgb, kLW, x, y), scene.background);
+  // ... and the caption takes several lines, none of them cut off.
+  const int bottom = lowest_dark_row(rgb, kLW, kLH);
+  EXPECT_GT(bottom, 2 * one_line_bottom) << "one line ends at row " << one_line_bottom;
+  EXPECT_LT(bottom, kLH / 2);
+  int right_half = 0;  // text beyond the first colon and the first line
+  for (int y = one_line_bottom + 4; y <= bottom; ++y)
+    for (int x = kLW / 2; x < kLW; ++x) right_half += dark(at(rgb, kLW, x, y)) ? 1 : 0;
+  EXPECT_GT(right_half, 30);
+}
+
+std::array<int, 3> bytes(const RenderColor& c) {
+  return {static_cast<int>(std::lround(c[0] * 255.0f)), static_cast<int>(std::lround(c[1] * 255.0f)),
+          static_cast<int>(std::lround(c[2] * 255.0f))};
+}
+
+int count_exact(const std::vector<std::uint8_t>& rgb, int width, int y0, int y1, const RenderColor& color) {
+  const auto c = bytes(color);
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < width; ++x) {
+      const Pixel p = at(rgb, width, x, y);
+      if (p.r == c[0] && p.g == c[1] && p.b == c[2]) ++n;
+    }
+  return n;
+}
+
+TEST(RenderLegend, PoleSwatchesUseThePoleColours) {
+  OffscreenRenderer renderer(kLW, kLH);
+  RenderFrame scene = blank_scene(kLW, kLH);
+  const auto plain = renderer.render(scene);
+  EXPECT_EQ(count_exact(plain, kLW, 0, kLH, palette::north), 0);
+  scene.legend.poles = true;
+  EXPECT_EQ(scene.legend.north, palette::north);
+  EXPECT_EQ(scene.legend.south, palette::south);
+  const auto rgb = renderer.render(scene);
+  // Filled swatches in the band at the bottom, nothing in the upper part.
+  EXPECT_GE(count_exact(rgb, kLW, kLH * 3 / 4, kLH, palette::north), 16);
+  EXPECT_GE(count_exact(rgb, kLW, kLH * 3 / 4, kLH, palette::south), 16);
+  for (int y = 0; y < kLH * 3 / 4; ++y)
+    for (int x = 0; x < kLW; ++x) ASSERT_EQ(at(rgb, kLW, x, y).g, at(plain, kLW, x, y).g);
+  // Other pole colours are drawn as given.
+  scene.legend.north = {0.9f, 0.5f, 0.0f};
+  EXPECT_GE(count_exact(renderer.render(scene), kLW, kLH * 3 / 4, kLH, scene.legend.north), 16);
+}
+
+TEST(RenderLegend, ColourBarShowsTheMap) {
+  OffscreenRenderer renderer(kLW, kLH);
+  RenderFrame scene = blank_scene(kLW, kLH);
+  for (int i = 0; i <= 4; ++i) scene.legend.colorbar.push_back(force_color(i / 4.0));
+  scene.legend.colorbar_high = 0.012;
+  const auto rgb = renderer.render(scene);
+  // Both ends of the map appear (bar samples at the pixel centres: within a
+  // few levels of the end colours).
+  for (const RenderColor& end : {force_color(0.0), force_color(1.0)}) {
+    const auto c = bytes(end);
+    int near = 0;
+    for (int y = kLH * 3 / 4; y < kLH; ++y)
+      for (int x = 0; x < kLW; ++x) {
+        const Pixel p = at(rgb, kLW, x, y);
+        if (std::abs(p.r - c[0]) + std::abs(p.g - c[1]) + std::abs(p.b - c[2]) < 24) ++near;
+      }
+    EXPECT_GE(near, 4);
+  }
+}
+
+// Longest horizontal run of pixels of exactly `color` in rows [y0, y1).
+int longest_run(const std::vector<std::uint8_t>& rgb, int width, int y0, int y1, const RenderColor& color) {
+  const auto c = bytes(color);
+  int best = 0;
+  for (int y = y0; y < y1; ++y) {
+    int run = 0;
+    for (int x = 0; x < width; ++x) {
+      const Pixel p = at(rgb, width, x, y);
+      run = (p.r == c[0] && p.g == c[1] && p.b == c[2]) ? run + 1 : 0;
+      best = std::max(best, run);
+    }
+  }
+  return best;
+}
+
+TEST(RenderLegend, ScaleBarMatchesTheCameraGeometry) {
+  OffscreenRenderer renderer(kLW, kLH);
+  struct Case {
+    double distance, fov;
+  };
+  for (const Case& c : {Case{0.5, 40.0}, Case{0.13, 40.0}, Case{3.0, 25.0}, Case{0.02, 60.0}}) {
+    SCOPED_TRACE(c.distance);
+    RenderFrame scene = blank_scene(kLW, kLH);
+    scene.camera.position = {0.0, -c.distance, 0.0};
+    scene.camera.fov_degrees = c.fov;
+    const auto plain = renderer.render(scene);
+    scene.legend.scale_bar = true;
+    const auto rgb = renderer.render(scene);
+    const int bar = longest_run(rgb, kLW, kLH * 3 / 4, kLH, scene.text_color);
+    EXPECT_EQ(longest_run(plain, kLW, 0, kLH, scene.text_color), 0);
+    // Pixels per metre at the target: the image height spans
+    // 2 d tan(fov / 2) metres there.
+    const double per_metre = kLH / (2.0 * c.distance * std::tan(c.fov / 2.0 * std::numbers::pi / 180.0));
+    const double metres = bar / per_metre;
+    // The bar's length is 1, 2 or 5 times a power of ten...
+    const double decade = std::pow(10.0, std::floor(std::log10(metres * 1.02)));
+    double nearest = 0.0;
+    for (double m : {1.0, 2.0, 5.0, 10.0})
+      if (std::abs(m * decade - metres) < std::abs(nearest - metres)) nearest = m * decade;
+    EXPECT_NEAR(bar, nearest * per_metre, 1.0) << metres << " m";
+    // ... and a readable part of the width.
+    EXPECT_GE(bar, 20);
+    EXPECT_LE(bar, kLW / 2);
+    const ScaleBar sb = scale_bar_for(scene.camera, kLH, 0.2 * kLW);
+    EXPECT_NEAR(sb.metres, nearest, 1e-9 * nearest);
+    EXPECT_NEAR(sb.pixels, bar, 1.0);
+  }
+  RenderCamera camera;
+  camera.position = {0.0, -0.5, 0.0};
+  camera.target = {0.0, 0.0, 0.0};
+  EXPECT_EQ(scale_bar_for(camera, 480, 100.0).label, "5 cm");  // 100 px span 7.6 cm there
+  EXPECT_EQ(scale_bar_for(camera, 480, 1500.0).label, "1 m");
+  EXPECT_EQ(scale_bar_for(camera, 480, 10.0).label, "5 mm");
+}
+
+TEST(RenderTranslucent, BallBehindGlassShows) {
+  RenderFrame scene = front_scene();
+  scene.primitives.push_back(RenderPrimitive::sphere({0, 0.05, 0}, 0.04, {0.9f, 0.1f, 0.1f}));
+  RenderPrimitive glass = RenderPrimitive::box({0, -0.02, 0}, {0.2, 0.01, 0.2}, Mat3{}, {0.75f, 0.85f, 0.9f});
+  scene.primitives.push_back(glass);
+  OffscreenRenderer renderer(kW, kH);
+  const Pixel opaque = at(renderer.render(scene), kW, kW / 2, kH / 2);
+  EXPECT_LT(opaque.r, opaque.b) << "an opaque pane hides the ball";
+  scene.primitives[1].opacity = 0.3f;
+  const auto rgb = renderer.render(scene);
+  const Pixel through = at(rgb, kW, kW / 2, kH / 2);
+  EXPECT_GT(through.r, through.g + 60) << through.r << "," << through.g << "," << through.b;
+  // The pane still tints the background around the ball.
+  const Pixel pane = at(rgb, kW, kW / 2 - 10, kH / 2);  // beside the ball, in front of the pane
+  const auto bg = bytes(scene.background);
+  EXPECT_GT(std::abs(pane.r - bg[0]) + std::abs(pane.g - bg[1]) + std::abs(pane.b - bg[2]), 6);
+  // Draw order does not matter: glass listed first.
+  std::swap(scene.primitives[0], scene.primitives[1]);
+  const Pixel swapped = at(renderer.render(scene), kW, kW / 2, kH / 2);
+  EXPECT_NEAR(swapped.r, through.r, 2);
+  EXPECT_NEAR(swapped.g, through.g, 2);
+}
+
 TEST(RenderSetup, RejectsBadSizes) {
   EXPECT_THROW(OffscreenRenderer(0, 10), std::invalid_argument);
   EXPECT_THROW(OffscreenRenderer(10, 10, 0), std::invalid_argument);
@@ -428,6 +641,28 @@ TEST(RenderRainbow, VioletToRedWithFallingHue) {
   EXPECT_EQ(rainbow(-1.0), rainbow(0.0));
   EXPECT_EQ(rainbow(2.0), rainbow(1.0));
   EXPECT_EQ(rainbow(std::nan("")), rainbow(0.0));
+}
+
+TEST(RenderForceColours, DistinctFromThePoleColours) {
+  const double north = hue_degrees(palette::north), south = hue_degrees(palette::south);
+  auto hue_gap = [](double a, double b) {
+    const double d = std::fmod(std::abs(a - b), 360.0);
+    return std::min(d, 360.0 - d);
+  };
+  double previous_brightness = -1.0;
+  for (int i = 0; i <= 20; ++i) {
+    const RenderColor c = force_color(i / 20.0);
+    SCOPED_TRACE(i);
+    EXPECT_GT(hue_gap(hue_degrees(c), north), 40.0);
+    EXPECT_GT(hue_gap(hue_degrees(c), south), 40.0);
+    EXPECT_FALSE(c[0] > 2 * c[1] && c[0] > 2 * c[2]);  // never red
+    const double brightness = c[0] + c[1] + c[2];
+    EXPECT_GT(brightness, previous_brightness);  // weak dark, strong bright
+    previous_brightness = brightness;
+  }
+  EXPECT_EQ(force_color(-1.0), force_color(0.0));
+  EXPECT_EQ(force_color(2.0), force_color(1.0));
+  EXPECT_EQ(force_color(std::nan("")), force_color(0.0));
 }
 
 }  // namespace

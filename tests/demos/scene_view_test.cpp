@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
@@ -48,7 +49,16 @@ TEST(SceneView, MagnetsSplitAlongTheirMagnetizationOthersInTheirColours) {
   EXPECT_EQ(norm(view.primitives[1].pole_axis), 0.0);       // soft ball: one colour
   EXPECT_NEAR(view.primitives[2].color[0], 0.6f, 1e-6);     // the material's colour
   ASSERT_EQ(view.text.size(), 2u);
-  EXPECT_EQ(view.text[1], "View test");                     // the title up to its colon
+  EXPECT_EQ(view.text[1], scene.title);                     // the whole title (wrapped by the renderer)
+  // The legend names the pole colours the magnet is drawn in, and a scale.
+  EXPECT_TRUE(view.legend.poles);
+  EXPECT_EQ(view.legend.north, view.primitives[0].north_color);
+  EXPECT_EQ(view.legend.south, view.primitives[0].south_color);
+  EXPECT_TRUE(view.legend.scale_bar);
+  EXPECT_TRUE(view.legend.colorbar.empty());  // force colours off
+  ViewOptions bare;
+  bare.legend = false;
+  EXPECT_FALSE(render_scene_of(sim, bare, nullptr).legend.any());
 }
 
 TEST(SceneView, ForceColoursRankBodiesByForce) {
@@ -57,8 +67,18 @@ TEST(SceneView, ForceColoursRankBodiesByForce) {
   Simulation sim(scene, make_cpu_backend(1));
   sim.step();
   const RenderFrame view = render_scene_of(sim, view_options(scene), nullptr);
-  // The ball feels the largest force: red (t = 1); the magnet keeps its poles.
-  EXPECT_LT(hue_degrees(view.primitives[1].color), 10.0);
+  // The ball feels the largest force: the top of the force map (yellow, not
+  // the north pole's red); the magnet keeps its poles.
+  EXPECT_EQ(view.primitives[1].color, force_color(1.0));
+  EXPECT_GT(hue_degrees(view.primitives[1].color), 40.0);
+  EXPECT_GT(norm(view.primitives[0].pole_axis), 0.0);
+  // The legend's colour bar: the same map, from 0 to the strongest force (N).
+  ASSERT_GE(view.legend.colorbar.size(), 2u);
+  EXPECT_EQ(view.legend.colorbar.front(), force_color(0.0));
+  EXPECT_EQ(view.legend.colorbar.back(), force_color(1.0));
+  EXPECT_EQ(view.legend.colorbar_low, 0.0);
+  EXPECT_NEAR(view.legend.colorbar_high, norm(sim.magnetics().force(1)), 1e-12);
+  EXPECT_EQ(view.legend.colorbar_unit, "N");
 }
 
 TEST(SceneView, FieldLinesLeaveTheNorthFaceAndReturnToTheMagnet) {
@@ -82,6 +102,135 @@ TEST(SceneView, FieldLinesLeaveTheNorthFaceAndReturnToTheMagnet) {
     }
   }
   EXPECT_GE(returned, 4);
+}
+
+// No permanent magnet: an electromagnet's core (a soft box driven by its coil
+// along +z) and a small steel ball far off.
+SceneDescription electromagnet_scene(const Vec3& coil_field) {
+  SceneDescription s;
+  s.file = "electromagnet";
+  s.gravity = {0, 0, 0};
+  s.simulation.ground = false;
+  SoftMaterial core;
+  core.saturation = 1.6e6;
+  core.susceptibility = 1000;
+  core.coil_field = coil_field;
+  s.materials["core"] = core;
+  SoftMaterial steel;
+  steel.saturation = 1.6e6;
+  steel.susceptibility = 1000;
+  s.materials["steel"] = steel;
+  s.bodies.push_back(test_support::body("core", Box{{0.02, 0.02, 0.04}}, "core", {0, 0, 0.05}, true));
+  s.bodies.push_back(test_support::body("ball", Sphere{0.003}, "steel", {0.08, 0, 0.05}, true));
+  s.cell_size = 0.005;
+  s.camera.position = {0.0, -0.3, 0.08};
+  s.camera.target = {0, 0, 0.05};
+  return s;
+}
+
+TEST(SceneView, FieldLinesStartAtAnElectromagnet) {
+  Simulation sim(electromagnet_scene({0, 0, 5e4}), make_cpu_backend(1));
+  sim.step();
+  const MagneticForces& m = sim.magnetics();
+  const auto sources = field_sources(m.model(), m.state());
+  ASSERT_GE(sources.size(), 1u);
+  EXPECT_EQ(sources[0].body, 0);
+  EXPECT_EQ(sources[0].kind, FieldSource::Kind::electromagnet);
+  EXPECT_GT(sources[0].axis.z, 0.99);  // magnetized along its coil
+  // The ball's induced moment is far below the core's: no lines of its own.
+  for (const FieldSource& s : sources) EXPECT_NE(s.body, 1);
+  auto backend = make_cpu_backend(1);
+  const auto lines = trace_field_lines(m.model(), m.state(), *backend, 8, 0.3);
+  ASSERT_EQ(lines.size(), 8u);
+  int returned = 0;
+  for (const RenderLine& line : lines) {
+    ASSERT_GE(line.points.size(), 2u);
+    const Vec3 start = line.points.front();
+    EXPECT_GT(start.z, 0.05 + 0.02) << "starts beyond the core's north (+z) face";
+    EXPECT_LT(start.z, 0.05 + 0.025);
+    EXPECT_LT(std::hypot(start.x, start.y), 0.01);
+    const Vec3 end = line.points.back();
+    if (std::abs(end.x) < 0.011 && std::abs(end.y) < 0.011 && std::abs(end.z - 0.05) < 0.021) {
+      ++returned;
+      EXPECT_LT(end.z, 0.05);  // back in through the south half
+    }
+  }
+  EXPECT_GE(returned, 4);
+  // Coil off and never magnetized: nothing to draw.
+  Simulation off(electromagnet_scene({0, 0, 0}), make_cpu_backend(1));
+  off.step();
+  EXPECT_TRUE(trace_field_lines(off.magnetics().model(), off.magnetics().state(), *backend, 8, 0.3).empty());
+}
+
+TEST(SceneView, FieldLinesStartAtAnInducedBody) {
+  // A steel ball in a uniform applied field, nothing else magnetic.
+  SceneDescription scene = electromagnet_scene({0, 0, 0});
+  scene.bodies.resize(2);
+  scene.bodies[0].material = "steel";  // a plain soft core: induced only
+  scene.external_field = {1e4, 0, 0};
+  Simulation sim(scene, make_cpu_backend(1));
+  sim.step();
+  const MagneticForces& m = sim.magnetics();
+  const auto sources = field_sources(m.model(), m.state());
+  ASSERT_GE(sources.size(), 1u);
+  EXPECT_EQ(sources[0].kind, FieldSource::Kind::induced);
+  EXPECT_GT(sources[0].axis.x, 0.9);  // along the applied field
+  auto backend = make_cpu_backend(1);
+  const auto lines = trace_field_lines(m.model(), m.state(), *backend, 8, 0.3);
+  ASSERT_FALSE(lines.empty());
+  for (const RenderLine& line : lines) {
+    const Vec3 start = line.points.front();
+    // On the +x face of the core or just outside the ball's +x side.
+    const bool at_core = start.x > 0.01 && start.x < 0.0125 && std::abs(start.z - 0.05) < 0.02;
+    const bool at_ball = start.x > 0.08 && norm(start - Vec3{0.08, 0, 0.05}) < 1.3 * 0.003;
+    EXPECT_TRUE(at_core || at_ball) << start.x << " " << start.y << " " << start.z;
+  }
+}
+
+TEST(SceneView, GlassTubeShowsTheBallInside) {
+  // A red ball in a square glass tube, seen through the tube's front wall.
+  SceneDescription s;
+  s.file = "tube";
+  s.title = "tube";
+  s.gravity = {0, 0, 0};
+  s.simulation.ground = false;
+  SoftMaterial steel;
+  steel.saturation = 1.6e6;
+  s.materials["steel"] = steel;
+  s.materials["glass"] = InertMaterial{};
+  s.material_colors["steel"] = {0.9, 0.1, 0.1};
+  s.material_colors["glass"] = {0.75, 0.85, 0.9};
+  auto add = [&](const std::string& name, const Shape& shape, const std::string& material, const Vec3& p) {
+    s.bodies.push_back(test_support::body(name, shape, material, p, true));
+  };
+  add("ball", Sphere{0.005}, "steel", {0, 0, 0.04});
+  add("tube_1", Box{{0.002, 0.03, 0.08}}, "glass", {0.0066, 0, 0.04});
+  add("tube_2", Box{{0.002, 0.03, 0.08}}, "glass", {-0.0066, 0, 0.04});
+  add("tube_3", Box{{0.03, 0.002, 0.08}}, "glass", {0, 0.0066, 0.04});
+  add("tube_4", Box{{0.03, 0.002, 0.08}}, "glass", {0, -0.0066, 0.04});
+  s.camera.position = {0.0, -0.15, 0.04};
+  s.camera.target = {0, 0, 0.04};
+  s.camera.width = 96;
+  s.camera.height = 72;
+  Simulation sim(s, make_cpu_backend(1));
+  sim.step();
+  ViewOptions options;
+  options.caption = false;
+  options.legend = false;
+  const RenderFrame view = render_scene_of(sim, options, nullptr);
+  ASSERT_EQ(view.primitives.size(), 5u);
+  EXPECT_EQ(view.primitives[0].opacity, 1.0f);
+  for (std::size_t i = 1; i < 5; ++i) EXPECT_LT(view.primitives[i].opacity, 0.5f);
+  OffscreenRenderer renderer(96, 72);
+  const auto rgb = renderer.render(view);
+  // The ball's red shows in the middle of the tube (the front wall covers it).
+  int red = 0;
+  for (int y = 30; y < 42; ++y)
+    for (int x = 42; x < 54; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * 96 + static_cast<std::size_t>(x)) * 3;
+      if (rgb[i] > rgb[i + 1] + 50 && rgb[i] > rgb[i + 2] + 50) ++red;
+    }
+  EXPECT_GT(red, 20);
 }
 
 TEST(SceneView, RunWritesOnePngPerFrame) {
