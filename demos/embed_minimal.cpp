@@ -1,9 +1,9 @@
 // odemag in a plain ODE program (docs/embedding.md): an iron ball dropped
 // beside a bar magnet lying on the ground is pulled to the magnet's pole.
 // The steps are split into substeps as in `odemag run` (MagneticStepper,
-// docs/embedding.md "Substeps"). Exits 0 when the ball ends up resting on the
-// magnet (within a thousandth of its radius, neither apart nor sunk in), 1
-// otherwise.
+// docs/embedding.md "Substeps"). Exits 0 when the ball rests on the magnet
+// (in the last second touching it, within a thousandth of its radius, in at
+// least 800 of the 1000 steps and never thrown off), 1 otherwise.
 #include <ode/ode.h>
 
 #include <algorithm>
@@ -62,17 +62,36 @@ int main() {
   // empty the contacts.
   odemag::MagneticStepper stepper(magnetics, world, space, near_callback, nullptr, contacts);
   int most = 1;  // substeps of a step
-  for (int step = 0; step < 2000; ++step)  // 2 s of 1 ms steps
+  // Ball surface to the magnet's surface, m (negative: inside).
+  const auto gap = [&] {
+    const dReal* p = dBodyGetPosition(ball);
+    const double dx = std::max(std::abs(p[0]) - 0.02, 0.0), dy = std::max(std::abs(p[1]) - 0.005, 0.0),
+                 dz = std::max(std::abs(p[2] - 0.005) - 0.005, 0.0);
+    return std::sqrt(dx * dx + dy * dy + dz * dz) - radius;
+  };
+  // Over the last second: steps touching the magnet (within a thousandth of
+  // the radius), and the deepest and farthest excursions. Without a contact
+  // surface layer ODE drops a resting contact now and then, and the pull then
+  // moves the ball a h^2 (1.8 mm at 1 ms) into the magnet for one step
+  // before the contact pushes it out (docs/embedding.md "Substeps").
+  int touching = 0;
+  double deepest = 0.0, farthest = 0.0;
+  for (int step = 0; step < 2000; ++step) {  // 2 s of 1 ms steps
     most = std::max(most, stepper.step(0.001).substeps);
+    if (step < 1000) continue;
+    const double g = gap();
+    touching += std::abs(g) < 1e-3 * radius ? 1 : 0;
+    deepest = std::min(deepest, g), farthest = std::max(farthest, g);
+  }
   const dReal* p = dBodyGetPosition(ball);
-  const double dx = std::max(std::abs(p[0]) - 0.02, 0.0), dy = std::max(std::abs(p[1]) - 0.005, 0.0),
-               dz = std::max(std::abs(p[2] - 0.005) - 0.005, 0.0);
-  const double gap = std::sqrt(dx * dx + dy * dy + dz * dz) - radius;  // ball surface to magnet
-  std::printf("ball at (%.4f, %.4f, %.4f) m, %.1e mm from the magnet, force on it %.3f N, up to %d substeps\n",
-              p[0], p[1], p[2], gap * 1e3, odemag::norm(magnetics.force(iron)), most);
+  std::printf("ball at (%.4f, %.4f, %.4f) m, %.1e mm from the magnet, force on it %.3f N, up to %d substeps; "
+              "last second: touching in %d of 1000 steps, %.2f mm deepest, %.2f mm farthest\n",
+              p[0], p[1], p[2], gap() * 1e3, odemag::norm(magnetics.force(iron)), most, touching, -deepest * 1e3,
+              farthest * 1e3);
   dJointGroupDestroy(contacts);
   dSpaceDestroy(space);  // and its geoms
   dWorldDestroy(world);
   dCloseODE();
-  return std::abs(gap) < 1e-3 * radius ? 0 : 1;
+  // Resting: touching in most steps, never thrown off.
+  return touching >= 800 && farthest < 0.1 * radius ? 0 : 1;
 }

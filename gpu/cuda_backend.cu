@@ -157,6 +157,14 @@ class CudaBackend final : public MagneticBackend {
   void begin_step(const MagneticModel& model, const MagneticState& state) override {
     select(device_);
     CallTimer timer(events_, stream(), stats_.begin_step);
+    // Bodies of graded cells carry per-pair tensors (MagneticBody::
+    // pair_tensors) that this backend does not sum: refuse them rather than
+    // give their cells no intra-body field (docs/model.md "Graded cells").
+    for (const MagneticBody& body : model.bodies())
+      if (body.cells.graded && body.responsive())
+        throw std::invalid_argument("CUDA backend: body \"" + body.name +
+                                    "\" has graded cells, which only the CPU backend supports "
+                                    "(MagneticModel::set_graded_cells(false) gives it a uniform lattice)");
     double up = upload_tables(model);
 
     // Bodies at this step (all of the model's, indexed by body).

@@ -84,6 +84,85 @@ ODEMAG_HD void cuboid_demag_tensor(const Vec3& p, const Vec3& half, double n[6])
   n[5] = k * zz;
 }
 
+// (A / R_A - B / R_B) / rho^2 with R = sqrt(rho^2 + Z^2), rho^2 = X^2 + Y^2, for
+// the two ends Z = A > B of a pair along one axis: the factor that the
+// gradient of the cuboid's tensor needs. Where A and B have the same sign (the
+// point beyond the ends of the edge's line) the difference is rewritten as
+// (A^2 - B^2) / (R_A R_B (A R_B + B R_A)), finite as rho -> 0; beside the
+// edge (B < 0 < A) it diverges like 1 / rho^2 on the edge itself (rho floored
+// at eps, as in log_pair).
+ODEMAG_HD double edge_ratio(double X, double Y, double A, double B, double eps) {
+  const double rho2 = fmax(X * X + Y * Y, eps * eps);
+  const double RA = sqrt(rho2 + A * A), RB = sqrt(rho2 + B * B);
+  if (A * B >= 0.0) {
+    const double den = A * RB + B * RA;
+    if (den != 0.0) return (A - B) * (A + B) / (RA * RB * den);
+  }
+  return (A / RA - B / RB) / rho2;
+}
+
+// The gradient of cuboid_demag_tensor: g[m][k] = dN_m / dp_k (m in the
+// order xx, xy, xz, yy, yz, zz). N = -grad grad psi with psi the Newtonian
+// potential of the cuboid, (1/4pi) int dV' / |p - p'|, so dN_ij / dp_k is
+// fully symmetric in i, j, k (10 components) and, because tr N is constant
+// off the surface (1 inside, 0 outside), dN_ii / dp_i = -sum_(j != i)
+// dN_jj / dp_i. With the corners as in cuboid_demag_tensor (s = sx sy sz):
+//   dN_xy / dz = (1/4pi) sum s / R,
+//   dN_xy / dx = dN_xx / dy = (1/4pi) sum_(sx, sy) sx sy X E(X, Y; z + c, z - c),
+//   dN_xy / dy = dN_yy / dx = (1/4pi) sum_(sx, sy) sx sy Y E(X, Y; z + c, z - c),
+// E = edge_ratio (from d log(Z + R) / dX = X / rho^2 - X Z / (R rho^2), whose
+// first term cancels between the two ends), and the other pairs by
+// permutation. Valid off the cuboid's surface; singular on its edges (like
+// N's off-diagonal logs) and, as the field's normal component jumps there,
+// meaningless on its faces.
+ODEMAG_HD void cuboid_demag_gradient(const Vec3& p, const Vec3& half, double g[6][3]) {
+  const double k = 1.0 / (4.0 * kPi);
+  const double eps = 1e-12 * (half.x + half.y + half.z);
+  const double P[3] = {p.x, p.y, p.z}, H[3] = {half.x, half.y, half.z};
+  // d[o][r] = dN_rr / dp_o = dN_ro / dp_r for o != r (the symmetry above).
+  double d[3][3] = {};
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j) {
+      const int l = 3 - i - j;  // the axis the pair runs along
+      double di = 0.0, dj = 0.0;
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+          const double si = a ? 1.0 : -1.0, sj = b ? 1.0 : -1.0;
+          const double Xi = P[i] - si * H[i], Xj = P[j] - sj * H[j];
+          const double e = edge_ratio(Xi, Xj, P[l] + H[l], P[l] - H[l], eps);
+          di += si * sj * Xi * e;
+          dj += si * sj * Xj * e;
+        }
+      d[i][j] = k * dj;  // dN_ij / dp_j = dN_jj / dp_i
+      d[j][i] = k * di;  // dN_ij / dp_i = dN_ii / dp_j
+    }
+  double xyz = 0.0;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b)
+      for (int c = 0; c < 2; ++c) {
+        const double sx = a ? 1.0 : -1.0, sy = b ? 1.0 : -1.0, sz = c ? 1.0 : -1.0;
+        const double X = P[0] - sx * H[0], Y = P[1] - sy * H[1], Z = P[2] - sz * H[2];
+        xyz += sx * sy * sz / sqrt(fmax(X * X + Y * Y + Z * Z, eps * eps));
+      }
+  xyz *= k;
+  // G(i, j, l) = dN_ij / dp_l, fully symmetric.
+  auto G = [&](int i, int j, int l) {
+    if (i != j && j != l && i != l) return xyz;
+    if (i == j && j == l) {
+      double s = 0.0;  // dN_ii / dp_i = -sum_(m != i) dN_mm / dp_i
+      for (int m = 0; m < 3; ++m)
+        if (m != i) s -= d[i][m];
+      return s;
+    }
+    // two equal indices: the repeated one r, the other o; dN_rr / dp_o = d[o][r].
+    const int r = i == j ? i : (i == l ? i : j), o = i + j + l - 2 * r;
+    return d[o][r];
+  };
+  constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+  for (int m = 0; m < 6; ++m)
+    for (int l = 0; l < 3; ++l) g[m][l] = G(row[m], col[m], l);
+}
+
 // H (A/m) at p (cuboid frame) of an axis-aligned cuboid with magnetization M.
 ODEMAG_HD Vec3 uniform_cuboid_field(const Vec3& p, const Vec3& half, const Vec3& M) {
   double n[6];

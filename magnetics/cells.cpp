@@ -392,6 +392,69 @@ bool uses_volume_shares(const Shape& shape, double cell_size) {
   return true;
 }
 
+namespace {
+
+// Cells per axis of a box at cell_size, as centre_inside_cells.
+std::array<int, 3> box_cell_counts(const Shape& shape, double cell_size) {
+  const Vec3 half = shape_half_extents(shape);
+  std::array<int, 3> n{};
+  for (int a = 0; a < 3; ++a)
+    n[a] = std::max(1, static_cast<int>(std::floor(2.0 * half[a] / cell_size + 1e-9)));
+  return n;
+}
+
+}  // namespace
+
+bool uses_graded_cells(const Shape& shape, double cell_size) {
+  if (!(cell_size > 0.0) || !std::holds_alternative<Box>(shape)) return false;
+  const std::array<int, 3> n = box_cell_counts(shape, cell_size);
+  for (int a = 0; a < 3; ++a)
+    if (n[a] < kMinGradedExtent) return false;
+  return static_cast<long>(n[0]) * n[1] * n[2] <= kMaxGradedCells;
+}
+
+CellSet make_graded_box_cells(const Shape& shape, double cell_size) {
+  if (!uses_graded_cells(shape, cell_size))
+    throw std::invalid_argument("make_graded_box_cells: not a box of graded cells at this cell size");
+  const Vec3 half = shape_half_extents(shape);
+  const std::array<int, 3> n = box_cell_counts(shape, cell_size);
+  // Faces per axis at the Chebyshev-Lobatto points x_k = -half cos(pi k / n).
+  std::array<std::vector<double>, 3> faces;
+  for (int a = 0; a < 3; ++a) {
+    faces[a].resize(n[a] + 1);
+    for (int k = 0; 2 * k <= n[a]; ++k) {  // mirror-symmetric to the bit
+      faces[a][k] = -half[a] * std::cos(kPi * k / n[a]);
+      faces[a][n[a] - k] = -faces[a][k];
+    }
+    if (n[a] % 2 == 0) faces[a][n[a] / 2] = 0.0;
+  }
+  CellSet cells;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        const int l[3] = {i, j, k};
+        Vec3 p, w;
+        for (int a = 0; a < 3; ++a) {
+          p[a] = 0.5 * (faces[a][l[a]] + faces[a][l[a] + 1]);
+          w[a] = 0.5 * (faces[a][l[a] + 1] - faces[a][l[a]]);
+        }
+        cells.local_positions.push_back(p);
+        cells.lattice_index.push_back({i, j, k});
+        cells.half_extents.push_back(w);
+        cells.volumes.push_back(8.0 * w.x * w.y * w.z);
+        cells.contact_radii.push_back(std::min({w.x, w.y, w.z}));
+      }
+  cells.faces = faces;
+  cells.lattice_extent = n;
+  cells.spacing = 2.0 * half.x / n[0];
+  cells.cell_volume = shape_volume(shape) / static_cast<double>(cells.size());
+  cells.cell_radius = std::cbrt(3.0 * cells.cell_volume / (4.0 * kPi));
+  cells.contact_radius = *std::max_element(cells.contact_radii.begin(), cells.contact_radii.end());
+  cells.whole_cells = false;
+  cells.graded = true;
+  return cells;
+}
+
 CellSet make_cells(const Shape& shape, double cell_size) {
   return uses_volume_shares(shape, cell_size) ? volume_share_cells(shape, cell_size)
                                               : centre_inside_cells(shape, cell_size);

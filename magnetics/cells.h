@@ -45,6 +45,15 @@ struct CellSet {
   // cubes: the body then gets the boundary correction (MagneticBody::
   // self_tensors).
   bool whole_cells = true;
+  // Graded cells (make_graded_box_cells): the cells tile a box as cuboids
+  // of different sizes, cell i of half extents half_extents[i] centred on its
+  // point; whole_cells is false (the volumes differ) and the body's
+  // intra-body tensors are per pair (MagneticBody::pair_tensors). spacing
+  // then is the mean width edge / n of the first axis, for code that wants a
+  // length scale. Empty half_extents for lattice cells (cubes of edge h).
+  bool graded = false;
+  std::vector<Vec3> half_extents;
+  std::array<std::vector<double>, 3> faces;  // graded: the n_a + 1 face positions per axis, m
 
   int size() const { return static_cast<int>(local_positions.size()); }
 };
@@ -61,6 +70,24 @@ struct CellSet {
 // for volume / N each (h^3 for boxes whose edges are multiples of h); a
 // lattice coarser than the body gives one cell at the centre.
 CellSet make_cells(const Shape& shape, double cell_size);
+
+// Graded cells of a box (docs/model.md "Graded cells"): per axis n =
+// floor(edge / h) cells (as make_cells) whose faces lie at the
+// Chebyshev-Lobatto points x_k = -(edge / 2) cos(pi k / n), k = 0 .. n: a
+// tensor-product grid with cells narrowing towards the faces (the face cells
+// about pi^2 / (4 n) of the mean width), where a soft body's magnetization is
+// singular (at its edges). Each cell is the cuboid between its faces,
+// standing for its volume at its centre. For uses_graded_cells shapes only
+// (std::invalid_argument otherwise).
+CellSet make_graded_box_cells(const Shape& shape, double cell_size);
+
+// True when a responsive body of this shape gets graded cells: a box at
+// least kMinGradedExtent cells along every axis with at most kMaxGradedCells
+// cells (their per-pair tensors take 48 n^2 bytes: 48 MB at 1000 cells).
+bool uses_graded_cells(const Shape& shape, double cell_size);
+
+inline constexpr int kMinGradedExtent = 4;
+inline constexpr int kMaxGradedCells = 1000;
 
 // True when make_cells gives the shape volume-share cells.
 bool uses_volume_shares(const Shape& shape, double cell_size);

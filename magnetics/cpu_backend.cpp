@@ -115,7 +115,14 @@ class CpuBackend final : public MagneticBackend {
                                sum_field(resp_.sources(), end, n, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]);
       // Intra-body: cached tensors of the body, in the body frame.
       const MagneticBody& body = model.body(b);
-      if (end - begin > 1) {
+      if (body.cells.graded) {
+        // Graded cells: per-pair tensors, the diagonal included (model.h).
+        const size_t row = static_cast<size_t>(resp.cell[i] - body.first_cell) * body.cell_count();
+        Vec3 hb;
+        for (int j = begin; j < end; ++j)
+          hb += symmetric_times(&body.pair_tensors[6u * (row + (resp.cell[j] - body.first_cell))], body_moment_[j]);
+        h += state.pose[b].rotation * hb;
+      } else if (end - begin > 1) {
         const auto& li = body.cells.lattice_index[resp.cell[i] - body.first_cell];
         Vec3 hb;
         for (int j = begin; j < end; ++j) {

@@ -1,5 +1,6 @@
 #include "magnetics/demag_tensor.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "magnetics/constants.h"
@@ -214,6 +215,131 @@ void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)
         if ((j == k) != (odd[m][j] != 0)) v *= sign[j];
       dn[k][m] = v;
     }
+}
+
+void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const double d[3], double n[6]) {
+  const double sign[3] = {d[0] < 0.0 ? -1.0 : (d[0] > 0.0 ? 1.0 : 0.0), d[1] < 0.0 ? -1.0 : (d[1] > 0.0 ? 1.0 : 0.0),
+                          d[2] < 0.0 ? -1.0 : (d[2] > 0.0 ? 1.0 : 0.0)};
+  const double X[3] = {std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])};
+  double edge = 0.0;
+  for (int k = 0; k < 3; ++k) edge = std::max({edge, 2.0 * half_a[k], 2.0 * half_b[k]});
+  const double range = kNewellRange * edge;
+  if (X[0] * X[0] + X[1] * X[1] + X[2] * X[2] > range * range) {
+    double t[6];
+    dipole_tensor({X[0], X[1], X[2]}, 0.0, t);  // H = T mu, mu = M V_b, H = -N M
+    const double vb = 8.0 * half_b[0] * half_b[1] * half_b[2];
+    for (int a = 0; a < 6; ++a) n[a] = -t[a] * vb;
+  } else {
+    // Per axis: the four corner differences of the two intervals and their
+    // weights (the double integral of a function of x - x' over both
+    // intervals is this combination of its second antiderivative).
+    double u[3][4];
+    for (int k = 0; k < 3; ++k) {
+      const double s = half_a[k] + half_b[k], t = half_a[k] - half_b[k];
+      u[k][0] = X[k] - s, u[k][1] = X[k] - t, u[k][2] = X[k] + t, u[k][3] = X[k] + s;
+    }
+    static constexpr double w[4] = {-1.0, 1.0, 1.0, -1.0};
+    static constexpr int order[6][3] = {{0, 1, 2}, {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 1, 0}};
+    static constexpr bool is_f[6] = {true, false, false, true, false, true};
+    double sum[6] = {0, 0, 0, 0, 0, 0};
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        for (int e = 0; e < 4; ++e) {
+          const double wt = w[a] * w[b] * w[e];
+          const NewellPoint pt(u[0][a], u[1][b], u[2][e]);
+          for (int m = 0; m < 6; ++m) {
+            const int* o = order[m];
+            double g[3];
+            sum[m] += wt * (is_f[m] ? pt.f(o[0], o[1], o[2], g) : pt.g(o[0], o[1], o[2], g));
+          }
+        }
+    const double c = 1.0 / (4.0 * kPi * 8.0 * half_a[0] * half_a[1] * half_a[2]);
+    for (int m = 0; m < 6; ++m) n[m] = c * sum[m];
+  }
+  // Components odd in an axis take its sign (zero offset: they vanish).
+  n[1] *= sign[0] * sign[1];
+  n[2] *= sign[0] * sign[2];
+  n[4] *= sign[1] * sign[2];
+}
+
+GridDemagTable::GridDemagTable(const std::array<std::vector<double>, 3>& faces) : faces_(faces) {
+  std::array<std::vector<double>, 3> values;
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<double>& F = faces_[k];
+    const int m = static_cast<int>(F.size());
+    std::vector<double>& v = values[k];
+    for (int p = 0; p < m; ++p)
+      for (int q = 0; q < m; ++q) v.push_back(std::fabs(F[p] - F[q]));
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    count_[k] = static_cast<int>(v.size());
+    index_[k].resize(static_cast<size_t>(m) * m);
+    for (int p = 0; p < m; ++p)
+      for (int q = 0; q < m; ++q)
+        index_[k][p * m + q] = static_cast<int>(
+            std::lower_bound(v.begin(), v.end(), std::fabs(F[p] - F[q])) - v.begin());
+  }
+  // Component m is f (xx, yy, zz) or g (xy, xz, yz) with its arguments in the
+  // order order[m], as cube_demag_tensor_at; at non-negative arguments.
+  static constexpr int order[6][3] = {{0, 1, 2}, {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 1, 0}};
+  static constexpr bool is_f[6] = {true, false, false, true, false, true};
+  table_.resize(6u * count_[0] * count_[1] * count_[2]);
+  for (int z = 0; z < count_[2]; ++z)
+    for (int y = 0; y < count_[1]; ++y)
+      for (int x = 0; x < count_[0]; ++x) {
+        const NewellPoint pt(values[0][x], values[1][y], values[2][z]);
+        double* t = &table_[6u * (x + static_cast<size_t>(count_[0]) * (y + static_cast<size_t>(count_[1]) * z))];
+        for (int c = 0; c < 6; ++c) {
+          const int* o = order[c];
+          double g[3];
+          t[c] = is_f[c] ? pt.f(o[0], o[1], o[2], g) : pt.g(o[0], o[1], o[2], g);
+        }
+      }
+}
+
+void GridDemagTable::tensor(const std::array<int, 3>& a, const std::array<int, 3>& b, double n[6]) const {
+  double half_a[3], half_b[3], d[3], edge = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<double>& F = faces_[k];
+    half_a[k] = 0.5 * (F[a[k] + 1] - F[a[k]]), half_b[k] = 0.5 * (F[b[k] + 1] - F[b[k]]);
+    d[k] = 0.5 * (F[a[k]] + F[a[k] + 1]) - 0.5 * (F[b[k]] + F[b[k] + 1]);
+    edge = std::max({edge, 2.0 * half_a[k], 2.0 * half_b[k]});
+  }
+  const double range = kNewellRange * edge;
+  if (d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > range * range) {
+    cuboid_demag_tensor(half_a, half_b, d, n);  // the point dipole
+    return;
+  }
+  // Per axis the corner differences u = F_p - F_q of cuboid_demag_tensor:
+  // (a, b + 1), (a, b), (a + 1, b + 1), (a + 1, b) with weights -1, 1, 1, -1.
+  int idx[3][4];
+  double sgn[3][4];
+  static constexpr double w[4] = {-1.0, 1.0, 1.0, -1.0};
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<double>& F = faces_[k];
+    const int m = static_cast<int>(F.size());
+    const int p[4] = {a[k], a[k], a[k] + 1, a[k] + 1}, q[4] = {b[k] + 1, b[k], b[k] + 1, b[k]};
+    for (int e = 0; e < 4; ++e) {
+      const double u = F[p[e]] - F[q[e]];
+      idx[k][e] = index_[k][p[e] * m + q[e]];
+      sgn[k][e] = u < 0.0 ? -1.0 : (u > 0.0 ? 1.0 : 0.0);
+    }
+  }
+  double sum[6] = {0, 0, 0, 0, 0, 0};
+  for (int z = 0; z < 4; ++z)
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 4; ++x) {
+        const double wt = w[x] * w[y] * w[z];
+        const double* t =
+            &table_[6u * (idx[0][x] + static_cast<size_t>(count_[0]) * (idx[1][y] + static_cast<size_t>(count_[1]) * idx[2][z]))];
+        // f even in every argument; g odd in its first two.
+        sum[0] += wt * t[0], sum[3] += wt * t[3], sum[5] += wt * t[5];
+        sum[1] += wt * sgn[0][x] * sgn[1][y] * t[1];
+        sum[2] += wt * sgn[0][x] * sgn[2][z] * t[2];
+        sum[4] += wt * sgn[1][y] * sgn[2][z] * t[4];
+      }
+  const double c = 1.0 / (4.0 * kPi * 8.0 * half_a[0] * half_a[1] * half_a[2]);
+  for (int m = 0; m < 6; ++m) n[m] = c * sum[m];
 }
 
 }  // namespace odemag

@@ -10,6 +10,9 @@
 // semi-definite, so soft bodies relax to their induced magnetization.
 #pragma once
 
+#include <array>
+#include <vector>
+
 namespace odemag {
 
 enum class IntraBodyTensor {
@@ -36,5 +39,36 @@ inline constexpr int kNewellRange = 16;
 // (|d_k| = h with overlapping projections, and d_k = 0 for overlapping cubes),
 // where the two-sided mean is returned. Beyond kNewellRange cells: the point dipole.
 void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)[6] = nullptr);
+
+// Demagnetising tensor of two aligned cuboids of half extents half_a (the
+// target) and half_b (the source) at offset d = centre of a - centre of b: the
+// mean field over cuboid a of cuboid b uniformly magnetized is -N M_b
+// (docs/model.md "Graded cells"). Newell's f and g at the corner differences
+// d_k + {-(a_k + b_k), -(a_k - b_k), a_k - b_k, a_k + b_k} per axis with
+// weights {-1, 1, 1, -1} (64 terms), over 4 pi V_a. For equal cubes of edge h
+// it is cube_demag_tensor; V_a N_ab = V_b N_ba; N(-d) = N(d); d = 0 and
+// half_a = half_b gives the cuboid's own demagnetising tensor. Beyond
+// kNewellRange times the larger edge of the two: the point dipole V_b D(d).
+void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const double d[3], double n[6]);
+
+// The cuboid-cuboid tensors between the cells of a tensor-product grid
+// (graded cells), faces[a] the n_a + 1 face positions along axis a: the
+// corner differences of any two cells are differences F_p - F_q of two
+// faces, so Newell's f and g are tabulated once at every |F_p - F_q| per
+// axis and each pair costs 64 table reads instead of 64 evaluations.
+// tensor(a, b) equals cuboid_demag_tensor of cells a and b (per-axis cell
+// indices) to round-off, the point dipole included beyond kNewellRange
+// times the larger edge; the 64-term sums are exactly symmetric in (a, b).
+class GridDemagTable {
+ public:
+  explicit GridDemagTable(const std::array<std::vector<double>, 3>& faces);
+  void tensor(const std::array<int, 3>& a, const std::array<int, 3>& b, double n[6]) const;
+
+ private:
+  std::array<std::vector<double>, 3> faces_;
+  std::array<std::vector<int>, 3> index_;  // per axis, (n + 1)^2: p (n + 1) + q -> index of |F_p - F_q|
+  std::array<int, 3> count_{0, 0, 0};      // distinct |F_p - F_q| per axis
+  std::vector<double> table_;              // the six functions at every (u_x, u_y, u_z)
+};
 
 }  // namespace odemag

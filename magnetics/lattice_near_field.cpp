@@ -299,7 +299,11 @@ class LatticeNearField final : public NearFieldTerm {
     std::vector<int> eligible;
     for (int b = 0; b < model.body_count(); ++b) {
       const MagneticBody& body = model.body(b);
-      if (body.inert() || !state.active[b] || body.cells.spacing <= 0.0 || body.cell_count() < 3) continue;
+      // Graded bodies (CellSet::graded) are not cubes on one lattice: they keep
+      // the point dipoles between bodies (docs/model.md "Graded cells").
+      if (body.inert() || !state.active[b] || body.cells.spacing <= 0.0 || body.cell_count() < 3 ||
+          body.cells.graded)
+        continue;
       LatticeBody& lb = bodies_[b];
       const double h = body.cells.spacing;
       for (int i = 0; i < body.cell_count(); ++i) lb.centroid += state.cell_position[body.first_cell + i];

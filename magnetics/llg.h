@@ -41,6 +41,12 @@ struct LocalRelaxOptions {
   double tolerance = 1e-12;        // relative torque at which a cell is relaxed
   double noise_ratio = 1e-6;       // |H_noise| / |H_eff| (paper Sec. 4.6)
   bool single_step = false;        // exactly one LLG step (paper Algorithm 1)
+  // Isotropic cells (H_K = 0) with opposite pairs of moments (n even) end on
+  // their exact minimum (isotropic_minimum), which fixes M from H_A alone;
+  // false: the Newton polish runs before it as well, as before issue 14 (it
+  // moved only the pair axes, and was most of the Newton steps of the crane's
+  // remanence phase: docs/benchmarks.md section 4).
+  bool polish_isotropic_pairs = false;
 };
 
 struct LocalRelaxResult {
@@ -145,10 +151,13 @@ ODEMAG_HD double cell_free_energy(const SoftCellParams& p, const Vec3& H_A, cons
   double e = -dot(H_A, mean_m) + 0.5 * p.gamma_D * p.Ms * squared_norm(mean_m);
   if (p.H_K != 0.0) {
     double s = 0.0;
-    for (int k = 0; k < p.n; ++k) {
-      const double c = dot(m[k], p.easy_axis);
-      s += 1.0 - c * c;
-    }
+    // |m_k x e|^2 = 1 - (m_k . e)^2 on the unit sphere, evaluated as the
+    // cross product: near the easy axis 1 - c^2 cancels to an absolute error
+    // of 1e-16 per moment, which times H_K / (2n) drowned the energy changes
+    // that the Newton polish's line search compares in weak fields (issue 14:
+    // 6% of the 8-moment cells' polishes then ran to the 40-step cap, 69% of
+    // the Newton steps of the crane's remanence phase).
+    for (int k = 0; k < p.n; ++k) s += squared_norm(cross(m[k], p.easy_axis));
     e += 0.5 * p.H_K * s / p.n;
   }
   return e;
@@ -371,7 +380,9 @@ ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, i
 // The exact minimum of an isotropic cell's free energy (H_K = 0): mean(m) =
 // t H_A/|H_A|, t = min(|H_A| / (gamma_D Ms), 1), with each opposite pair
 // (m_2j, m_2j+1) placed symmetrically about H_A and its axis turned as little
-// as possible. Applied after the Newton polish, which cannot resolve weak
+// as possible. Applied instead of the Newton polish where every moment has
+// its pair (n even), after it otherwise (or with
+// LocalRelaxOptions::polish_isotropic_pairs). The polish cannot resolve weak
 // fields: the curvature of the pair-axis mode, |H_A|^2 / (gamma_D Ms), is
 // lost to round-off next to gamma_D Ms, so for iron the polish stopped with M
 // 13-32% off at 1e-4..1e-2 A/m and 2e-7 off at 1 A/m, where its torque
@@ -426,7 +437,12 @@ ODEMAG_HD LocalRelaxResult relax_soft_cell(const SoftCellParams& p, const Vec3& 
     ++r.llg_steps;
     r.residual = cell_torque_residual(p, H_A, m);
   }
-  if (o.newton) r.newton_steps = newton_polish(p, H_A, m, o.max_newton_steps, o.tolerance, r.residual);
+  // An isotropic cell of opposite pairs has one minimum, put in closed form
+  // below: mean(m) = min(|H_A| / (gamma_D Ms), 1) H_A / |H_A| whatever the
+  // pair axes, so a polish would turn only the axes.
+  const bool closed_form = o.newton && p.H_K == 0.0 && p.n % 2 == 0 && !o.polish_isotropic_pairs;
+  if (o.newton && !closed_form)
+    r.newton_steps = newton_polish(p, H_A, m, o.max_newton_steps, o.tolerance, r.residual);
   if (o.newton && p.H_K == 0.0) {
     isotropic_minimum(p, H_A, m);
     r.residual = cell_torque_residual(p, H_A, m);

@@ -46,6 +46,28 @@ void build_offset_tensors(MagneticBody& body, IntraBodyTensor kind) {
       }
 }
 
+// Per-pair tensors of a body of graded cells (MagneticBody::pair_tensors):
+// T_ij = -N_ij / V_j, symmetric in (i, j) because V_i N_ij = V_j N_ji (the
+// Galerkin energy of the tiling), so each pair is computed once; the
+// diagonal carries the cell's own tensor beyond I / 3.
+void build_pair_tensors(MagneticBody& body) {
+  const CellSet& cells = body.cells;
+  const int count = cells.size();
+  const GridDemagTable table(cells.faces);  // cuboid_demag_tensor from tabulated f and g
+  body.pair_tensors.assign(6u * count * count, 0.0);
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int i = 0; i < count; ++i) {
+    for (int j = 0; j <= i; ++j) {
+      double n[6];
+      table.tensor(cells.lattice_index[i], cells.lattice_index[j], n);
+      if (i == j) n[0] -= 1.0 / 3.0, n[3] -= 1.0 / 3.0, n[5] -= 1.0 / 3.0;
+      double* tij = &body.pair_tensors[6u * (static_cast<size_t>(i) * count + j)];
+      double* tji = &body.pair_tensors[6u * (static_cast<size_t>(j) * count + i)];
+      for (int c = 0; c < 6; ++c) tij[c] = tji[c] = -n[c] / cells.volumes[j];
+    }
+  }
+}
+
 // Boundary correction (docs/model.md "Cells"). For a uniform magnetization M
 // the cells' field is H_i = -(I/3 + sum_{j != i} w_j N_ij) M (self term and
 // cube tensors of the cubes at the lattice sites, w_j = V_j / h^3), while the
@@ -174,7 +196,13 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
   body.shape = shape;
   body.material = material;
   body.first_cell = cell_count();
-  if (!is_inert(material)) body.cells = make_cells(shape, cell_size);
+  const bool responsive_material =
+      std::holds_alternative<SoftMaterial>(material) ||
+      (std::holds_alternative<PermanentMaterial>(material) &&
+       std::get<PermanentMaterial>(material).recoil_susceptibility > 0.0);
+  const bool graded = graded_cells_ && intra_tensor_ == IntraBodyTensor::cell_average && responsive_material &&
+                      uses_graded_cells(shape, cell_size);
+  if (!is_inert(material)) body.cells = graded ? make_graded_box_cells(shape, cell_size) : make_cells(shape, cell_size);
 
   if (const auto* pm = std::get_if<PermanentMaterial>(&material)) {
     body.remanence = pm->magnetization;
@@ -190,7 +218,9 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     body.soft.n = sm->moments_per_cell;
     body.coil_field = sm->coil_field;
   }
-  if (body.responsive() && body.cell_count() > 1) {
+  if (body.responsive() && body.cells.graded) {
+    build_pair_tensors(body);
+  } else if (body.responsive() && body.cell_count() > 1) {
     build_offset_tensors(body, intra_tensor_);
     if (!body.cells.whole_cells && intra_tensor_ == IntraBodyTensor::cell_average) build_boundary_correction(body);
   }

@@ -40,6 +40,13 @@ struct MagneticBody {
   // the cube-cube tensor, or the point dipole (magnetics/demag_tensor.h).
   std::vector<double> offset_tensors;
   std::array<int, 3> offset_extent{0, 0, 0};  // 2 n - 1 per axis
+  // Bodies of graded cells (CellSet::graded) instead: per pair (i, j), at
+  // 6 (i n + j), H_i += T_ij mu_j with T_ij = -N_ij / V_j, N_ij the
+  // cuboid-cuboid tensor (cuboid_demag_tensor; T_ij = T_ji since V_i N_ij =
+  // V_j N_ji), and on the diagonal T_ii = -(N_ii - I / 3) / V_i: the
+  // cell's own demagnetising tensor beyond the cube's I / 3 that the local
+  // relaxation (gamma_D) already holds. offset_tensors is empty then.
+  std::vector<double> pair_tensors;
   // Boundary correction of the intra-body field of a responsive body with
   // partial cells (docs/model.md "Cells"; magnetics/state.h add_boundary_field),
   // body frame, six components per symmetric tensor. Empty when not needed
@@ -115,6 +122,14 @@ class MagneticModel {
   MagneticModel() = default;
   explicit MagneticModel(IntraBodyTensor intra_tensor) : intra_tensor_(intra_tensor) {}
   IntraBodyTensor intra_body_tensor() const { return intra_tensor_; }
+  // Graded cells (docs/model.md "Graded cells") for the responsive boxes
+  // added from now on that uses_graded_cells accepts, with the cell_average
+  // tensor. Off by default (the uniform lattice of cubes): the lattice near
+  // field between touching bodies (magnetics/lattice_near_field.cpp) and
+  // field probes treat cells as cubes of edge h, and the CUDA backend
+  // refuses graded bodies.
+  void set_graded_cells(bool on) { graded_cells_ = on; }
+  bool graded_cells() const { return graded_cells_; }
 
   // This model's contents (ModelGeneration): unique to the model object and
   // new after every add_body.
@@ -152,6 +167,7 @@ class MagneticModel {
 
  private:
   IntraBodyTensor intra_tensor_ = IntraBodyTensor::cell_average;
+  bool graded_cells_ = false;
   std::vector<MagneticBody> bodies_;
   std::vector<int> cell_body_;
   std::vector<int> moment_offset_;

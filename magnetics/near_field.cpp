@@ -5,6 +5,7 @@ namespace odemag {
 NearField::NearField() {
   terms_.push_back(make_sphere_near_field());
   terms_.push_back(make_lattice_near_field());
+  terms_.push_back(make_ball_lattice_near_field());
 }
 
 void NearField::build(const MagneticModel& model, const MagneticState& state, bool enabled,

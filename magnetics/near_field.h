@@ -13,6 +13,13 @@
 //   they use the cell-averaged (Newell) tensor: face neighbours across a
 //   contact couple 18% too strongly. LatticeNearField replaces the point
 //   dipole by the cell-averaged tensor for close pairs of aligned lattices.
+// - A one-cell ball next to a lattice body couples with each close cell as
+//   with a point dipole, while the cell is a cube (in a box body: its cuboid
+//   part of the box) whose field at the ball's centre, the field the ball's
+//   dipole answers, is far from a dipole's within a few h (3.9 times the
+//   force for a ball touching the ball chain's magnet). BallLatticeNearField
+//   replaces the point dipole by the cuboid's exact field (dipole level: the
+//   ball's induced higher orders are not included).
 //
 // Each correction is a short list of close pairs rebuilt once per rigid step
 // (build); the backends add its field to the dense sums at every outer
@@ -64,6 +71,7 @@ class NearFieldTerm {
 
 std::unique_ptr<NearFieldTerm> make_sphere_near_field();
 std::unique_ptr<NearFieldTerm> make_lattice_near_field();
+std::unique_ptr<NearFieldTerm> make_ball_lattice_near_field();
 
 // All near-field terms of a model; what the backends hold.
 class NearField {

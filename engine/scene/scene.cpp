@@ -792,6 +792,8 @@ const KeyTable<SolverSettings> kSolverKeys = {
      .doc = {"bool", "", "`false`"}},
     {.name = "near_field", .check = Check::boolean, .slot = SLOT(relax.near_field),
      .doc = {"bool", "", "`true`"}},
+    {.name = "graded_cells", .check = Check::boolean, .slot = SLOT(graded_cells),
+     .doc = {"bool", "", "`false`"}},
     {.name = "backend", .check = Check::choice, .slot = SLOT(backend), .words = {"cpu", "cuda", "auto"},
      .late = true, .doc = {"string", "", "`\"auto\"`"}},
     {.name = "threads", .check = Check::integer, .slot = SLOT(threads),

@@ -66,6 +66,9 @@ struct SolverSettings {
   RelaxOptions relax;          // scheme, tolerance, max_iterations, mutual_induction, ...
   std::string backend = "auto";  // "cpu", "cuda", "auto"
   int threads = 0;             // 0: all cores
+  // Graded cells for responsive boxes (MagneticModel::set_graded_cells,
+  // docs/model.md "Graded cells"); CPU backend only ("auto" then picks it).
+  bool graded_cells = false;
 };
 
 struct ContactSettings {

@@ -18,6 +18,7 @@ BodyPose scene_pose(const BodyDescription& body) {
 
 MagneticSystem build_magnetic_system(const SceneDescription& scene) {
   MagneticSystem ms;
+  ms.model.set_graded_cells(scene.solver.graded_cells);
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodyDescription& body = scene.bodies[b];
     const auto material = scene.materials.find(body.material);
@@ -76,8 +77,11 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene) {
 }
 
 std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threads,
-                                              std::string* notice) {
+                                              std::string* notice, bool graded_cells) {
   if (name == "cpu") return make_cpu_backend(threads);
+  if (graded_cells && name == "cuda")
+    throw std::invalid_argument("backend \"cuda\" does not support graded cells (solver.graded_cells)");
+  if (graded_cells && name == "auto") return make_cpu_backend(threads);
   if (name == "cuda" || name == "auto") {
     std::string why;
     if (auto gpu = make_cuda_backend(&why)) return gpu;

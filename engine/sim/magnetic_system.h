@@ -48,7 +48,9 @@ BodyPose scene_pose(const BodyDescription& body);
 // Backend by name: "cpu", "cuda" or "auto". "auto" falls back to the CPU
 // backend when no CUDA device is usable and writes one notice to `notice`;
 // "cuda" without a device throws std::invalid_argument (usage error, exit 2).
+// graded_cells (SolverSettings::graded_cells): the CPU backend only, so
+// "auto" picks it and "cuda" throws.
 std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threads,
-                                              std::string* notice);
+                                              std::string* notice, bool graded_cells = false);
 
 }  // namespace odemag

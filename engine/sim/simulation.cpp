@@ -178,6 +178,8 @@ void Simulation::step() {
     ++record.relaxations;
     const RelaxReport& report = magnetics_->last_report();
     record.iterations += report.iterations;
+    record.llg_steps += report.llg_steps;
+    record.newton_steps += report.newton_steps;
     record.skipped += report.skipped ? 1 : 0;
     record.converged = record.converged && report.converged;
     record.residual = std::max(record.residual, report.residual);

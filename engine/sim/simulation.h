@@ -26,6 +26,8 @@ struct StepRecord {
   // hold (docs/hard-cases.md: 1 mm objects at 4 ms steps).
   int substeps_wanted = 1;
   int iterations = 0;        // outer relaxation iterations, summed over the substeps
+  long llg_steps = 0;        // per-cell LLG steps of those relaxations, summed over cells
+  long newton_steps = 0;     // per-cell Newton steps of those relaxations, summed over cells
   int relaxations = 0;       // substeps that relaxed the magnetization (SimulationSettings::magnetic_solve)
   int skipped = 0;           // substeps whose magnetic step was skipped (solver.skip_unchanged)
   bool converged = true;

@@ -26,6 +26,13 @@
 // change of a body's moment or force 7e-6 at tolerance 1e-4, crane_small),
 // and the differences grow over the scenes' contact dynamics. The iron
 // plate, without one-cell sphere pairs, kept its hash.
+//
+// Re-pinned (stop 15) for two physics changes: the near field of a one-cell
+// ball next to a lattice body (magnetics/ball_lattice_near_field.cpp: the
+// cells' cube fields instead of point dipoles within 3 h; every pinned scene
+// has balls touching a lattice magnet or plate), and the anisotropy energy of
+// the Newton polish's line search summed as |m x e|^2 (magnetics/llg.h; it
+// alone moved nail_and_balls). Outcomes: docs/scenes.md "stop 15".
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -86,10 +93,10 @@ struct Case {
 };
 
 const Case kCases[] = {
-    {"ball_chain", 1.5, 0x5d2d2ffcca7062bbULL},
-    {"iron_plate", 1.7, 0xe4aac92123770948ULL},
-    {"thin_iron_plate", 1.0, 0xe0e01d51f85588d8ULL},
-    {"nail_and_balls", 3.2, 0x7cc99497aee76426ULL},
+    {"ball_chain", 1.5, 0x94684e707f032e43ULL},
+    {"iron_plate", 1.7, 0x2c031f171626dddfULL},
+    {"thin_iron_plate", 1.0, 0x9e4f5b7ba09ec036ULL},
+    {"nail_and_balls", 3.2, 0x5d3cc816574fcecfULL},
 };
 
 // Set by tests/engine/CMakeLists.txt for a Release build with

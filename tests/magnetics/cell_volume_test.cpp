@@ -380,7 +380,13 @@ TEST(CellVolume, CoaxialCylinderForceWithTheNearField) {
 // line of centres, within 3% (measured: 1.25% at most). Two balls in a field
 // along the line are within 3% from a gap of 0.5 R (0.54%); closer the field
 // concentrates in a contact zone of width ~ sqrt(2 g R), about one cell at
-// 0.1 R: 4.7% at 0.1 R, 10.5% at 0.05 R (docs/validation.md, not met).
+// 0.1 R: 4.7% at 0.1 R, 10.5% at 0.05 R (docs/validation.md, not met). That
+// is the resolution of M, one vector per cell: the error falls as h^2 (test
+// 12) and is nearly the same at chi = 10 (9.2% / 4.8%), and coupling the
+// balls' boundary cells across the contact by sub-cubes of their true shape
+// (edge h/2, h/4) moved it only to 10.1% / 4.5% (h/2) and 10.0% (h/4, 0.05 R).
+// Those two rows are checked against their measured errors, so that a change
+// that makes them worse shows.
 Vec3 lattice_ball_force(double R_over_h, double gap_over_R, const Vec3& magnet, const Vec3& H0, int* iterations) {
   const double R = 0.005, chi = 1000;
   MagneticModel model;
@@ -420,13 +426,13 @@ TEST(CellVolume, LatticeBallForcesMatchTheExactSolutions) {
     }
     for (const Vec3& H0 : {Vec3{0, 0, 1e3}, Vec3{1e3, 0, 0}}) {
       const bool along = H0.z > 0.0;
-      if (along && g < 0.5) continue;  // not met (above)
+      const double tolerance = along && g < 0.5 ? (g < 0.075 ? 0.11 : 0.05) : 0.03;  // above
       const Vec3 F = lattice_ball_force(k, g, {}, H0, &it);
       const auto ref = reference::two_linear_spheres_in_uniform_field(R, chi, R, chi, {0, 0, 0}, p, H0);
       const double e = norm(F - ref.force_on_2) / norm(ref.force_on_2);
       std::printf("[odemag] two lattice balls, gap %g R, field %s: force error %.2e (%d iterations)\n", g,
                   along ? "along" : "across", e, it);
-      EXPECT_LT(e, 0.03) << "gap " << g << " R";
+      EXPECT_LT(e, tolerance) << "gap " << g << " R";
     }
   }
 }
@@ -439,6 +445,29 @@ TEST(CellVolume, TouchingLatticeBallsConverge) {
     int it = 0;
     lattice_ball_force(5.5, g, {}, {0, 0, 1e4}, &it);
     EXPECT_LT(it, RelaxOptions{}.max_iterations);
+  }
+}
+
+// 12. Two lattice balls in a field along the line of centres near contact
+// (gaps 0.05 R and 0.1 R): the force error against the exact solution falls
+// with the cell size at least as h^1.5 from R/h = 4 to 5.5 (measured: 22.1% ->
+// 10.5% and 10.4% -> 4.7%, about h^2; 7.4% / 3.1% at R/h = 6.5 and 5.3% / 2.2%
+// at R/h = 7.5, 1497 and 2295 cells per ball). So 3% at 0.1 R needs R/h
+// ~ 6.6 (about 1660 cells per ball), at 0.05 R R/h ~ 9.7 (about 4800).
+TEST(CellVolume, LatticeBallsAlongTheLineConvergeNearContact) {
+  const double R = 0.005, chi = 1000;
+  const Vec3 H0{0, 0, 1e3};
+  for (double g : {0.05, 0.1}) {
+    const auto ref = reference::two_linear_spheres_in_uniform_field(R, chi, R, chi, {0, 0, 0}, {0, 0, (2.0 + g) * R}, H0);
+    double e[2];
+    const double k[2] = {4.0, 5.5};
+    for (int n = 0; n < 2; ++n) {
+      int it = 0;
+      const Vec3 F = lattice_ball_force(k[n], g, {}, H0, &it);
+      e[n] = norm(F - ref.force_on_2) / norm(ref.force_on_2);
+      std::printf("[odemag] two lattice balls, field along, gap %g R, R/h %g: force error %.3e\n", g, k[n], e[n]);
+    }
+    EXPECT_LT(e[1], e[0] * std::pow(k[0] / k[1], 1.5)) << "gap " << g << " R";
   }
 }
 

@@ -1,0 +1,347 @@
+// Close pairs of a one-cell ball and a cell of a lattice body: the exact
+// field of the cell's cube instead of the point dipole (magnetics/near_field.h;
+// docs/model.md "The near field").
+//
+// The dense sums couple a one-cell ball (radius R, dipole mu_b = V_b M_b) and a
+// lattice cell c (spacing h, mu_c = V_c M_c) as two point dipoles, H = T(r; s)
+// mu (magnetics/kernels.h). Inside its body the cell is a cube of edge h
+// centred on its cell point, magnetization mu_c / V (V = the body's
+// CellSet::cell_volume, h^3 for volume-share cells: the convention of the
+// intra-body tensors and of lattice_near_field.cpp). In a box body every
+// cell's part of the body is itself a cuboid, centred on the cell point (its
+// centroid), with extents e_k = min(h, 2 (L_k/2 - |x_k|)) and volume V_i: there
+// the cell is that cuboid with magnetization mu_c / V_i, so that the cells'
+// fields add up to the box's exactly, also for a plate thinner than h (whose
+// cubes would stand out of its faces, into a touching ball). A ball touching the
+// body's face sits R from the cube's face, r = h/2 + R from its centre, where
+// the point dipole is far from the cube's field (the ball chain's magnet, h =
+// 20 mm, R = 5 mm: r = 0.75 h). Two exact statements give the pair tensor:
+// the mean of a harmonic field over a ball is its value at the centre, so the
+// ball's dipole answers the cube's field at its centre; and a uniformly
+// magnetized ball's external field is exactly a point dipole, whose mean
+// over the cube is, by reciprocity, the same tensor acting on mu_b. So
+//
+//   T_c(r) = -R_X N(R_X^T r; e/2) R_X^T / V,   r = x_b - x_c,
+//
+// N the point demagnetising tensor of the cuboid (cuboid_demag_tensor,
+// magnetics/cell_field.h), R_X the lattice body's rotation, and this term adds
+//
+//   H_b += K mu_c,  H_c += K mu_b,  U = -mu0 mu_b . K mu_c,
+//   K = w(r) [T_c(r) - T(r; s)],    s = the pair's contact distance.
+//
+// Window w = w_out(|r|) w_in(delta), both C2 quintic steps:
+// - w_out: 1 up to kCutoffStart h, 0 beyond kCutoffEnd h (centre distance),
+//   as lattice_near_field.cpp; for a cube |T_c - T| / |T| ~ (h / r)^4 there
+//   (no quadrupole): a fixed dipole next to the ball chain's magnet (3 x 3 x 2
+//   cubes of 20 mm, R = 5 mm, gaps 0.05 .. 4 R) gets the box's force to 1.1e-3
+//   (point dipoles: up to 3.9 times off). A flat partial cuboid has a
+//   quadrupole: a 5 mm plate of 20 mm cells is off by up to 1.4e-2 at 4 R
+//   (point dipoles: up to 31 times).
+// - w_in: in delta = the distance from the ball's centre to the cube (0 when
+//   inside), 1 above kFadeStart R, 0 below kFadeEnd R. A ball that touches a
+//   box body has delta >= R for every cell's cuboid; the fade only
+//   acts where the ball's centre comes within 0.75 R of a cube (overlapping
+//   bodies), before the cube's field jumps at its face or diverges (logarithmically)
+//   at its edges: fields and forces stay bounded and continuous through
+//   overlap down to coincident centres, where only the dense sums' bounded
+//   core is left. Where several cubes meet on the body's surface their
+//   edge terms cancel exactly (equal weights: all have delta >= R at contact).
+//
+// Forces: F_b = mu0 grad_r (w phi0) = -F_c, phi0 = mu_b . (T_c - T) mu_c, with
+// the cube tensor's analytic gradient (cuboid_demag_gradient) and the dense
+// kernel's (dipole_force). Torques: mu0 mu x (K mu) at both cells (the
+// backends' field output), and, since T_c and w_in turn with the lattice body,
+// the pure torque -dU/dtheta of turning its frame alone,
+//
+//   tau_X = -mu0 [ r x (phi0 w_out grad w_in + w g_c) + w (mu_b x T_c mu_c + mu_c x T_c mu_b) ],
+//
+// g_c = grad_r (mu_b . T_c mu_c) (rotating r, mu_b, mu_c and the frame together
+// leaves U unchanged). It is applied as the rigid force couple F_i = (J^-1 tau)
+// x (x_i - x_bar) over the body's cells (as lattice_near_field.cpp); bodies with
+// fewer than three or collinear cells take no correction, nor do models with
+// point-dipole intra-body tensors (a lattice body's cells are point dipoles
+// there).
+//
+// Balls: one-cell bodies of shape Sphere (permanent, soft or recoil). One-cell
+// boxes and cylinders are point dipoles in the model with a field that is not
+// one outside them; they are left as they are. Without mutual induction the
+// backends evaluate no responsive sources, so the pairs between a soft ball
+// and a soft core then act in the forces only, like the dense sums.
+//
+// Pair search: every ball against every lattice body's bounding sphere (cell
+// points), then that body's cells: O(balls x lattice bodies + their close
+// cells). Pairs in a fixed order, summed on one thread.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <variant>
+
+#include "magnetics/cell_field.h"
+#include "magnetics/constants.h"
+#include "magnetics/kernels.h"
+#include "magnetics/near_field.h"
+
+namespace odemag {
+
+namespace {
+
+// Outer window in the centre distance, units of h.
+constexpr double kCutoffStart = 2.0;
+constexpr double kCutoffEnd = 3.0;
+// Inner window in the distance from the ball's centre to the cube, units of R.
+constexpr double kFadeEnd = 0.5;    // below: no correction
+constexpr double kFadeStart = 0.75;  // above: full correction
+// Lattice bodies need cells spread in 3 dimensions to take a pure torque:
+// smallest eigenvalue of J above this times h^2.
+constexpr double kMinCoupleInertia = 0.1;
+
+// C2 step S(t) = t^3 (10 - 15 t + 6 t^2) on [0, 1], clamped; slope dS/dt.
+double quintic_step(double t, double& slope) {
+  if (t <= 0.0 || t >= 1.0) {
+    slope = 0.0;
+    return t <= 0.0 ? 0.0 : 1.0;
+  }
+  slope = 30.0 * t * t * (1.0 - t) * (1.0 - t);
+  return t * t * t * (10.0 + t * (6.0 * t - 15.0));
+}
+
+// The pair's geometry: windows and the cube tensor, with gradients (world).
+struct PairGeometry {
+  double w = 0.0, w_out = 0.0, w_in = 0.0;
+  Vec3 grad_w, grad_w_in;  // grad_r
+  double Tc[6];            // T_c(r), world, 1/m^3
+  double dTc[3][6];        // dT_c / dr_k, world, 1/m^4 (only with gradients)
+};
+
+// Rotated symmetric tensor R S R^T (six components xx, xy, xz, yy, yz, zz).
+void rotate_symmetric(const Mat3& R, const double s[6], double out[6]) {
+  constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+  const double S[3][3] = {{s[0], s[1], s[2]}, {s[1], s[3], s[4]}, {s[2], s[4], s[5]}};
+  double RS[3][3];
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) RS[a][b] = R.m[a][0] * S[0][b] + R.m[a][1] * S[1][b] + R.m[a][2] * S[2][b];
+  for (int m = 0; m < 6; ++m) {
+    const int a = row[m], b = col[m];
+    out[m] = RS[a][0] * R.m[b][0] + RS[a][1] * R.m[b][1] + RS[a][2] * R.m[b][2];
+  }
+}
+
+// Windows and T_c at offset r = x_b - x_c (world) of a ball of radius R from a
+// cube of edge h, volume V, frame R_X; with_gradient: also the gradients.
+PairGeometry pair_geometry(const Vec3& r, const Mat3& R_X, double h, const Vec3& half, double V, double R,
+                           bool with_gradient) {
+  PairGeometry g;
+  const double d = norm(r);
+  double s_out;
+  g.w_out = 1.0 - quintic_step((d / h - kCutoffStart) / (kCutoffEnd - kCutoffStart), s_out);
+  if (g.w_out == 0.0) return g;
+  const Vec3 l = R_X.transpose_times(r);
+  // delta = |max(|l_k| - half_k, 0)|, C1 off the cuboid.
+  Vec3 outside;
+  for (int k = 0; k < 3; ++k) outside[k] = std::max(std::fabs(l[k]) - half[k], 0.0) * (l[k] < 0.0 ? -1.0 : 1.0);
+  const double delta = norm(outside);
+  double s_in;
+  g.w_in = quintic_step((delta / R - kFadeEnd) / (kFadeStart - kFadeEnd), s_in);
+  g.w = g.w_out * g.w_in;
+  if (g.w == 0.0) return g;
+  double n[6];
+  cuboid_demag_tensor(l, half, n);
+  for (double& v : n) v /= -V;
+  rotate_symmetric(R_X, n, g.Tc);
+  if (!with_gradient) return g;
+  // grad_r delta = R_X (outside / delta) (delta > 0 where w_in > 0).
+  g.grad_w_in = (s_in / ((kFadeStart - kFadeEnd) * R * delta)) * (R_X * outside);
+  const Vec3 grad_w_out = (-s_out / ((kCutoffEnd - kCutoffStart) * h * d)) * r;
+  g.grad_w = g.w_in * grad_w_out + g.w_out * g.grad_w_in;
+  // dT_c/dr_k = -R_X (sum_j R_jk dN/dl_j) R_X^T / V.
+  double dn[6][3];
+  cuboid_demag_gradient(l, half, dn);
+  for (int k = 0; k < 3; ++k) {
+    double local[6];
+    for (int m = 0; m < 6; ++m)
+      local[m] = -(dn[m][0] * R_X.m[k][0] + dn[m][1] * R_X.m[k][1] + dn[m][2] * R_X.m[k][2]) / V;
+    rotate_symmetric(R_X, local, g.dTc[k]);
+  }
+  return g;
+}
+
+struct Ball {
+  int cell = -1;
+  int body = -1;
+  double radius = 0.0;
+};
+
+struct LatticeBody {
+  int body = -1;
+  double h = 0.0;
+  double volume = 0.0;  // V of T_c for a cube cell (CellSet::cell_volume)
+  const Box* box = nullptr;  // a box body's shape: its cells' parts are cuboids
+  Vec3 centroid;        // of the cell points
+  double radius = 0.0;  // bounding sphere about it
+  Eigen::Matrix3d J_inverse = Eigen::Matrix3d::Zero();
+};
+
+struct BallCellPair {
+  int ball = -1, lattice = -1;  // indices into balls_, lattices_
+  int b = -1, c = -1;           // cells
+  Vec3 half;                    // half extents of the cell's cuboid (body frame)
+  double volume = 0.0;          // V of T_c
+  double K[6];                  // world, 1/m^3
+};
+
+class BallLatticeNearField final : public NearFieldTerm {
+ public:
+  void build(const MagneticModel& model, const MagneticState& state) override {
+    balls_.clear();
+    lattices_.clear();
+    pairs_.clear();
+    if (model.intra_body_tensor() != IntraBodyTensor::cell_average) return;
+    for (int bi = 0; bi < model.body_count(); ++bi) {
+      const MagneticBody& body = model.body(bi);
+      if (body.inert() || !state.active[bi]) continue;
+      if (body.cells.spacing <= 0.0) {
+        if (body.cell_count() == 1 && std::holds_alternative<Sphere>(body.shape))
+          balls_.push_back({body.first_cell, bi, body.cells.contact_radius});
+        continue;
+      }
+      if (body.cell_count() < 3 || body.cells.graded) continue;  // graded: point dipoles (lattice_near_field.cpp)
+      LatticeBody lb;
+      lb.body = bi;
+      lb.h = body.cells.spacing;
+      lb.volume = body.cells.cell_volume;
+      lb.box = std::get_if<Box>(&body.shape);
+      for (int i = 0; i < body.cell_count(); ++i) lb.centroid += state.cell_position[body.first_cell + i];
+      lb.centroid = lb.centroid / body.cell_count();
+      Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+      for (int i = 0; i < body.cell_count(); ++i) {
+        const Vec3 d = state.cell_position[body.first_cell + i] - lb.centroid;
+        lb.radius = std::max(lb.radius, norm(d));
+        const Eigen::Vector3d e(d.x, d.y, d.z);
+        J += e.squaredNorm() * Eigen::Matrix3d::Identity() - e * e.transpose();
+      }
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(J);
+      if (eig.eigenvalues()(0) < kMinCoupleInertia * lb.h * lb.h) continue;  // collinear cells
+      lb.J_inverse = J.inverse();
+      lattices_.push_back(lb);
+    }
+    for (int bi = 0; bi < static_cast<int>(balls_.size()); ++bi) {
+      const Ball& ball = balls_[bi];
+      const Vec3& xb = state.cell_position[ball.cell];
+      for (int li = 0; li < static_cast<int>(lattices_.size()); ++li) {
+        const LatticeBody& lb = lattices_[li];
+        if (norm(xb - lb.centroid) >= lb.radius + kCutoffEnd * lb.h) continue;
+        const MagneticBody& body = model.body(lb.body);
+        const Mat3& R_X = state.pose[lb.body].rotation;
+        for (int i = 0; i < body.cell_count(); ++i) {
+          const int c = body.first_cell + i;
+          const Vec3 r = xb - state.cell_position[c];
+          BallCellPair p;
+          cell_solid(model, lb, c, p.half, p.volume);
+          const PairGeometry g = pair_geometry(r, R_X, lb.h, p.half, p.volume, ball.radius, false);
+          if (g.w == 0.0) continue;
+          p.ball = bi, p.lattice = li, p.b = ball.cell, p.c = c;
+          const double s = model.cell_contact_radius(ball.cell) + model.cell_contact_radius(c);
+          double t[6];
+          dipole_tensor(r, s * s, t);
+          for (int m = 0; m < 6; ++m) p.K[m] = g.w * (g.Tc[m] - t[m]);
+          pairs_.push_back(p);
+        }
+      }
+    }
+  }
+
+  void add_field(const MagneticModel& model, const MagneticState& state, NearFieldSources sources,
+                 std::vector<Vec3>& H) const override {
+    const bool responsive_sources = sources == NearFieldSources::responsive;
+    for (const BallCellPair& p : pairs_) {
+      const bool resp_b = model.body(balls_[p.ball].body).responsive();
+      const bool resp_c = model.body(lattices_[p.lattice].body).responsive();
+      if (resp_b && resp_c == responsive_sources) H[p.b] += symmetric_times(p.K, moment(model, state, p.c));
+      if (resp_c && resp_b == responsive_sources) H[p.c] += symmetric_times(p.K, moment(model, state, p.b));
+    }
+  }
+
+  void add_forces(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& force,
+                  std::vector<Vec3>& field) const override {
+    std::vector<Vec3> torque(lattices_.size());
+    for (const BallCellPair& p : pairs_) {
+      const LatticeBody& lb = lattices_[p.lattice];
+      const Vec3 mu_b = moment(model, state, p.b), mu_c = moment(model, state, p.c);
+      const Vec3 r = state.cell_position[p.b] - state.cell_position[p.c];
+      const PairGeometry g =
+          pair_geometry(r, state.pose[lb.body].rotation, lb.h, p.half, p.volume, balls_[p.ball].radius, true);
+      if (g.w == 0.0) continue;
+      const double s = model.cell_contact_radius(p.b) + model.cell_contact_radius(p.c);
+      const Vec3 Tc_mu_c = symmetric_times(g.Tc, mu_c), Tc_mu_b = symmetric_times(g.Tc, mu_b);
+      const Vec3 T_mu_c = dipole_field(r, mu_c, s * s), T_mu_b = dipole_field(r, mu_b, s * s);
+      const double phi0 = dot(mu_b, Tc_mu_c - T_mu_c);
+      Vec3 g_c;  // grad_r (mu_b . T_c mu_c)
+      for (int k = 0; k < 3; ++k) g_c[k] = dot(mu_b, symmetric_times(g.dTc[k], mu_c));
+      // F_b = mu0 grad_r (w phi0); dipole_force is mu0 grad_r (mu_b . T mu_c).
+      const Vec3 F_b = kMu0 * (phi0 * g.grad_w + g.w * g_c) - g.w * dipole_force(r, mu_c, mu_b, s * s);
+      force[p.b] += F_b;
+      force[p.c] -= F_b;
+      field[p.b] += g.w * (Tc_mu_c - T_mu_c);
+      field[p.c] += g.w * (Tc_mu_b - T_mu_b);
+      // The lattice frame's pure torque (header comment).
+      torque[p.lattice] -= kMu0 * (cross(r, (phi0 * g.w_out) * g.grad_w_in + g.w * g_c) +
+                                   g.w * (cross(mu_b, Tc_mu_c) + cross(mu_c, Tc_mu_b)));
+    }
+    for (std::size_t li = 0; li < lattices_.size(); ++li) {
+      const Vec3& tau = torque[li];
+      if (tau.x == 0.0 && tau.y == 0.0 && tau.z == 0.0) continue;
+      const LatticeBody& lb = lattices_[li];
+      const Eigen::Vector3d omega = lb.J_inverse * Eigen::Vector3d(tau.x, tau.y, tau.z);
+      const MagneticBody& body = model.body(lb.body);
+      for (int i = 0; i < body.cell_count(); ++i) {
+        const int c = body.first_cell + i;
+        force[c] += cross(Vec3{omega(0), omega(1), omega(2)}, state.cell_position[c] - lb.centroid);
+      }
+    }
+  }
+
+  double energy(const MagneticModel& model, const MagneticState& state) const override {
+    double e = 0.0;
+    for (const BallCellPair& p : pairs_)
+      e -= kMu0 * dot(moment(model, state, p.b), symmetric_times(p.K, moment(model, state, p.c)));
+    return e;
+  }
+
+  int pair_count() const override { return static_cast<int>(pairs_.size()); }
+
+ private:
+  static Vec3 moment(const MagneticModel& model, const MagneticState& state, int cell) {
+    return model.cell_volume(cell) * state.magnetization[cell];
+  }
+
+  // The solid a cell's field comes from: in a box body its part of the body,
+  // the cuboid centred on its cell point (the part's centroid) with extents
+  // e_k = min(h, 2 (L_k/2 - |c_k|)) (a boundary cell's part reaches the box's
+  // face), magnetization mu / V_i; otherwise its cube, mu / cell_volume.
+  static void cell_solid(const MagneticModel& model, const LatticeBody& lb, int c, Vec3& half, double& volume) {
+    const double h = lb.h;
+    half = {0.5 * h, 0.5 * h, 0.5 * h};
+    volume = lb.volume;
+    if (!lb.box) return;
+    const MagneticBody& body = model.body(lb.body);
+    const Vec3& x = body.cells.local_positions[c - body.first_cell];
+    Vec3 e;
+    for (int k = 0; k < 3; ++k) e[k] = std::min(h, 2.0 * (0.5 * lb.box->size[k] - std::fabs(x[k])));
+    const double V = model.cell_volume(c);
+    // Only where the extents account for the part's volume (a lattice whose
+    // cells are not cuboid parts of the box keeps the cube).
+    if (!(e.x > 0.0 && e.y > 0.0 && e.z > 0.0) || std::fabs(e.x * e.y * e.z - V) > 1e-6 * V) return;
+    half = 0.5 * e;
+    volume = V;
+  }
+
+  std::vector<Ball> balls_;
+  std::vector<LatticeBody> lattices_;
+  std::vector<BallCellPair> pairs_;
+};
+
+}  // namespace
+
+std::unique_ptr<NearFieldTerm> make_ball_lattice_near_field() { return std::make_unique<BallLatticeNearField>(); }
+
+}  // namespace odemag
