@@ -7,6 +7,12 @@
 #include "magnetics/constants.h"
 
 namespace odemag {
+namespace {
+// Largest travel in one substep, in units of the body's size (smallest half
+// extent): in free flight, and for a body that touched something.
+constexpr double kFreeTravel = 0.1;
+constexpr double kContactTravel = 0.3;
+}  // namespace
 
 SubstepBody substep_body(const MagneticBody& body, const dMass& mass) {
   SubstepBody s;
@@ -39,11 +45,17 @@ int SubstepRule::needed(double dt, const std::vector<SubstepMotion>& motion, dou
     // force, and the angular acceleration times the bounding radius), at most
     // L: a tenth of the body's size, three tenths for a body that was in
     // contact (which most likely still holds it; it may have lifted off by a
-    // hair, so its acceleration still counts). Solved for h.
+    // hair, so its acceleration still counts). Solved for h. The contact
+    // allowance is for what the contact holds back (the acceleration): the
+    // velocity's own travel v h stays within a tenth of the size, or a body
+    // pushed off another at speed (two magnets started inside each other)
+    // or rolling off a magnet meets the floor up to 0.3 of its size deep
+    // (docs/hard-cases.md "Substeps").
     const double v = norm(s.velocity) + norm(s.angular_velocity) * reach;
     const double a = f / m + gravity + (inertia > 0.0 ? norm(s.torque) / inertia * reach : 0.0);
-    const double L = (s.in_contact ? 0.3 : 0.1) * size;
+    const double L = (s.in_contact ? kContactTravel : kFreeTravel) * size;
     shortest = std::min(shortest, 2.0 * L / (v + std::sqrt(v * v + 2.0 * a * L)));
+    if (s.in_contact && v > 0.0) shortest = std::min(shortest, kFreeTravel * size / v);
     // Time scale of the magnetic force: it varies over distances of the
     // body's size, so it oscillates a body about an equilibrium at
     // omega^2 ~ |F| / (m size); and the torque about an orientation at

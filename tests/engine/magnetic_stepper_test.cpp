@@ -190,6 +190,17 @@ TEST(SubstepRule, TravelBoundAndHold) {
   EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 1);
   motion[0].velocity = {5.0, 0, 0};  // 5 mm per step: ten substeps of 0.5 mm
   EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 10);
+  // In contact the allowance is 0.3 of the size for what the contact holds
+  // back (1.5 mm under 3000 m/s^2: h = sqrt(2 L / a) = 1 ms), but the
+  // velocity's own travel stays 0.1 of it: a body sliding or pushed off at
+  // speed gets the free-flight count (the 0.3 allowance gave 4 substeps).
+  motion[0].in_contact = true;
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 10);
+  motion[0].velocity = {};
+  motion[0].force = {3000.0 * 0.004 * 0.999, 0, 0};
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 1) << "held by the contact (omega h = 0.77)";
+  motion[0].in_contact = false;
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 2) << "free: sqrt(2 * 0.5 mm / a) = 0.58 ms";
   motion[0].free = false;  // kinematic or disabled: not counted
   EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 1);
   EXPECT_EQ(rule.update(10, 0.0, 0.001, true), 10);
