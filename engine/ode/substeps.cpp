@@ -48,8 +48,8 @@ int SubstepRule::needed(double dt, const std::vector<SubstepMotion>& motion, dou
     // hair, so its acceleration still counts). Solved for h. The contact
     // allowance is for what the contact holds back (the acceleration): the
     // velocity's own travel v h stays within a tenth of the size, or a body
-    // pushed off another at speed (two magnets started inside each other)
-    // or rolling off a magnet meets the floor up to 0.3 of its size deep
+    // that moves fast while touching another (two lattice magnets started at
+    // one centre spin apart) meets the floor up to 0.3 of its size deep
     // (docs/hard-cases.md "Substeps").
     const double v = norm(s.velocity) + norm(s.angular_velocity) * reach;
     const double a = f / m + gravity + (inertia > 0.0 ? norm(s.torque) / inertia * reach : 0.0);

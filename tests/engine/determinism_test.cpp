@@ -37,8 +37,8 @@
 // Re-pinned (stop 16) for the substep rule: a body in contact travels at
 // most a tenth of its size per substep with its own velocity
 // (engine/ode/substeps.cpp; the 0.3 contact allowance let two lattice
-// magnets pushed apart from an overlap reach 10% of their size into the
-// floor). Only nail_and_balls moved (its nail slides on the magnet).
+// magnets started at one centre spin apart and reach 5.8% of their half
+// extent into the floor). Only nail_and_balls moved.
 // Outcomes: docs/scenes.md "stop 16".
 #include <gtest/gtest.h>
 
