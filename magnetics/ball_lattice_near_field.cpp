@@ -69,10 +69,15 @@
 // and a soft core then act in the forces only, like the dense sums.
 //
 // Pair search: every ball against every lattice body's bounding sphere (cell
-// points), then that body's cells: O(balls x lattice bodies + their close
-// cells). Pairs in a fixed order, summed on one thread.
+// points), then the cells of the face-plane slots within 3 h of the ball
+// (SharedCorners): O(balls x lattice bodies + their close cells). Each cell's
+// cube tensor is assembled from corner and edge terms that the cells meeting
+// there share, computed once per ball (CuboidCornerTerms); build evaluates
+// every pair with its gradient, and add_forces reuses that at unchanged poses.
+// Pairs in a fixed order, summed on one thread.
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <variant>
 
@@ -126,16 +131,16 @@ void rotate_symmetric(const Mat3& R, const double s[6], double out[6]) {
   }
 }
 
-// Windows and T_c at offset r = x_b - x_c (world) of a ball of radius R from a
-// cube of edge h, volume V, frame R_X; with_gradient: also the gradients.
-PairGeometry pair_geometry(const Vec3& r, const Mat3& R_X, double h, const Vec3& half, double V, double R,
-                           bool with_gradient) {
-  PairGeometry g;
+// The windows at offset r = x_b - x_c (world) of a ball of radius R from a
+// cuboid of half extents `half`, frame R_X, cell spacing h; l = R_X^T r.
+// false: the pair has no weight (the tensor is then not needed).
+bool pair_windows(const Vec3& r, const Mat3& R_X, double h, const Vec3& half, double R, bool with_gradient,
+                  PairGeometry& g, Vec3& l) {
   const double d = norm(r);
   double s_out;
   g.w_out = 1.0 - quintic_step((d / h - kCutoffStart) / (kCutoffEnd - kCutoffStart), s_out);
-  if (g.w_out == 0.0) return g;
-  const Vec3 l = R_X.transpose_times(r);
+  if (g.w_out == 0.0) return false;
+  l = R_X.transpose_times(r);
   // delta = |max(|l_k| - half_k, 0)|, C1 off the cuboid.
   Vec3 outside;
   for (int k = 0; k < 3; ++k) outside[k] = std::max(std::fabs(l[k]) - half[k], 0.0) * (l[k] < 0.0 ? -1.0 : 1.0);
@@ -143,27 +148,177 @@ PairGeometry pair_geometry(const Vec3& r, const Mat3& R_X, double h, const Vec3&
   double s_in;
   g.w_in = quintic_step((delta / R - kFadeEnd) / (kFadeStart - kFadeEnd), s_in);
   g.w = g.w_out * g.w_in;
-  if (g.w == 0.0) return g;
-  double n[6];
-  cuboid_demag_tensor(l, half, n);
-  for (double& v : n) v /= -V;
-  rotate_symmetric(R_X, n, g.Tc);
-  if (!with_gradient) return g;
+  if (g.w == 0.0) return false;
+  if (!with_gradient) return true;
   // grad_r delta = R_X (outside / delta) (delta > 0 where w_in > 0).
   g.grad_w_in = (s_in / ((kFadeStart - kFadeEnd) * R * delta)) * (R_X * outside);
   const Vec3 grad_w_out = (-s_out / ((kCutoffEnd - kCutoffStart) * h * d)) * r;
   g.grad_w = g.w_in * grad_w_out + g.w_out * g.grad_w_in;
+  return true;
+}
+
+// T_c (world) and, with_gradient, dT_c/dr from the cuboid's corner terms in
+// its frame R_X, volume V.
+void pair_tensor(const CuboidCornerTerms& t, const Mat3& R_X, double V, bool with_gradient, PairGeometry& g) {
+  double n[6];
+  cuboid_demag_tensor(t, n);
+  for (double& v : n) v /= -V;
+  rotate_symmetric(R_X, n, g.Tc);
+  if (!with_gradient) return;
   // dT_c/dr_k = -R_X (sum_j R_jk dN/dl_j) R_X^T / V.
   double dn[6][3];
-  cuboid_demag_gradient(l, half, dn);
+  cuboid_demag_gradient(t, dn);
   for (int k = 0; k < 3; ++k) {
     double local[6];
     for (int m = 0; m < 6; ++m)
       local[m] = -(dn[m][0] * R_X.m[k][0] + dn[m][1] * R_X.m[k][1] + dn[m][2] * R_X.m[k][2]) / V;
     rotate_symmetric(R_X, local, g.dTc[k]);
   }
+}
+
+// Windows and T_c at offset r = x_b - x_c (world) of a ball of radius R from a
+// cube of edge h, volume V, frame R_X; with_gradient: also the gradients.
+PairGeometry pair_geometry(const Vec3& r, const Mat3& R_X, double h, const Vec3& half, double V, double R,
+                           bool with_gradient) {
+  PairGeometry g;
+  Vec3 l;
+  if (!pair_windows(r, R_X, h, half, R, with_gradient, g, l)) return g;
+  CuboidCornerTerms t;
+  cuboid_corner_terms(l, half, with_gradient, t);
+  pair_tensor(t, R_X, V, with_gradient, g);
   return g;
 }
+
+// A lattice body's cells as solids between face planes: per axis the sorted
+// distinct planes (body frame) and each cell's lower plane, its upper being the
+// next (lattices whose solids tile the body: box parts and cubes on a grid).
+// For one ball at a time (begin) the corner terms of every corner and edge its
+// pairs need are computed once and shared by the cells that meet there
+// (CuboidCornerTerms): a cell's eight corners are shared by up to eight cells.
+class SharedCorners {
+ public:
+  // false: the solids do not tile planes; the pairs then take per-cell terms.
+  bool build(const std::vector<Vec3>& lower, const std::vector<Vec3>& upper, double h) {
+    const int n = static_cast<int>(lower.size());
+    const double tol = 1e-9 * h;
+    lower_plane_.assign(n, {});
+    for (int k = 0; k < 3; ++k) {
+      std::vector<double> v;
+      for (int i = 0; i < n; ++i) {
+        v.push_back(lower[i][k]);
+        v.push_back(upper[i][k]);
+      }
+      std::sort(v.begin(), v.end());
+      planes_[k].clear();
+      for (double x : v)
+        if (planes_[k].empty() || x - planes_[k].back() > tol) planes_[k].push_back(x);
+      for (int i = 0; i < n; ++i) {
+        const auto lo = std::lower_bound(planes_[k].begin(), planes_[k].end(), lower[i][k] - tol);
+        const int j = static_cast<int>(lo - planes_[k].begin());
+        if (j + 1 >= static_cast<int>(planes_[k].size()) || std::fabs(planes_[k][j + 1] - upper[i][k]) > tol)
+          return false;
+        lower_plane_[i][k] = j;
+      }
+    }
+    for (int k = 0; k < 3; ++k) count_[k] = static_cast<int>(planes_[k].size());
+    cell_at_.assign(static_cast<std::size_t>(count_[0] - 1) * (count_[1] - 1) * (count_[2] - 1), -1);
+    for (int i = 0; i < n; ++i) {
+      int& slot = cell_at_[slab(lower_plane_[i][0], lower_plane_[i][1], lower_plane_[i][2])];
+      if (slot >= 0) return false;  // two solids in one slot: not a tiling
+      slot = i;
+    }
+    corners_.assign(static_cast<std::size_t>(count_[0]) * count_[1] * count_[2], {});
+    for (int e = 0; e < 3; ++e)
+      edges_[e].assign(static_cast<std::size_t>(count_[kU[e]]) * count_[kW[e]] * (count_[kAlong[e]] - 1), {});
+    eps_ = cuboid_snap_distance({0.5 * h, 0.5 * h, 0.5 * h});
+    return true;
+  }
+
+  // The cells whose solids reach within `reach` of q (body frame) along every
+  // axis, in a fixed order: a superset of the cells whose centres lie within
+  // `reach` of q.
+  void cells_near(const Vec3& q, double reach, std::vector<int>& cells) const {
+    cells.clear();
+    int first[3], last[3];
+    for (int k = 0; k < 3; ++k) {
+      const std::vector<double>& v = planes_[k];
+      // slots j with v[j + 1] >= q - reach and v[j] <= q + reach
+      first[k] = std::max(0, static_cast<int>(std::lower_bound(v.begin(), v.end(), q[k] - reach) - v.begin()) - 1);
+      last[k] = std::min(count_[k] - 2,
+                         static_cast<int>(std::upper_bound(v.begin(), v.end(), q[k] + reach) - v.begin()) - 1);
+      if (first[k] > last[k]) return;
+    }
+    for (int i = first[0]; i <= last[0]; ++i)
+      for (int j = first[1]; j <= last[1]; ++j)
+        for (int l = first[2]; l <= last[2]; ++l) {
+          const int c = cell_at_[slab(i, j, l)];
+          if (c >= 0) cells.push_back(c);
+        }
+  }
+
+  // The next ball, at q in the body frame.
+  void begin(const Vec3& q) {
+    q_ = q;
+    ++generation_;
+  }
+
+  // Cell i's corner terms at the current ball (with the gradient's terms).
+  void terms(int i, CuboidCornerTerms& t) {
+    const int lo[3] = {lower_plane_[i][0], lower_plane_[i][1], lower_plane_[i][2]};
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 2; ++a) t.offset[k][a] = q_[k] - planes_[k][lo[k] + a];
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b)
+        for (int c = 0; c < 2; ++c) {
+          Corner& x = corners_[(static_cast<std::size_t>(lo[0] + a) * count_[1] + lo[1] + b) * count_[2] + lo[2] + c];
+          if (x.generation != generation_) {
+            cuboid_corner(t.offset[0][a], t.offset[1][b], t.offset[2][c], eps_, x.angle, x.inverse_distance);
+            x.generation = generation_;
+          }
+          for (int m = 0; m < 3; ++m) t.angle[a][b][c][m] = x.angle[m];
+          t.inverse_distance[a][b][c] = x.inverse_distance;
+        }
+    for (int e = 0; e < 3; ++e)
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+          const int u = kU[e], w = kW[e], along = kAlong[e];
+          Edge& x = edges_[e][(static_cast<std::size_t>(lo[u] + a) * count_[w] + lo[w] + b) * (count_[along] - 1) +
+                              lo[along]];
+          if (x.generation != generation_) {
+            cuboid_edge(t.offset[u][a], t.offset[w][b], t.offset[along][0], t.offset[along][1], eps_, x.log_term,
+                        x.ratio);
+            x.generation = generation_;
+          }
+          t.log_pair[e][a][b] = x.log_term;
+          t.edge_ratio[e][a][b] = x.ratio;
+        }
+  }
+
+ private:
+  // Edge e runs along axis kAlong[e] between planes of axes kU[e], kW[e] (CuboidCornerTerms).
+  static constexpr int kU[3] = {0, 0, 1}, kW[3] = {1, 2, 2}, kAlong[3] = {2, 1, 0};
+  struct Corner {
+    double angle[3];
+    double inverse_distance;
+    long generation = 0;
+  };
+  struct Edge {
+    double log_term, ratio;
+    long generation = 0;
+  };
+  std::vector<double> planes_[3];
+  int count_[3] = {};
+  std::size_t slab(int i, int j, int l) const {
+    return (static_cast<std::size_t>(i) * (count_[1] - 1) + j) * (count_[2] - 1) + l;
+  }
+  std::vector<std::array<int, 3>> lower_plane_;
+  std::vector<int> cell_at_;  // per slot between consecutive planes: the cell there, or -1
+  std::vector<Corner> corners_;
+  std::vector<Edge> edges_[3];
+  double eps_ = 0.0;
+  long generation_ = 0;
+  Vec3 q_;
+};
 
 struct Ball {
   int cell = -1;
@@ -171,23 +326,43 @@ struct Ball {
   double radius = 0.0;
 };
 
+// A lattice body's data that depend on the model only (rebuilt when its
+// generation changes), and its pose-dependent part (every build).
 struct LatticeBody {
   int body = -1;
   double h = 0.0;
   double volume = 0.0;  // V of T_c for a cube cell (CellSet::cell_volume)
   const Box* box = nullptr;  // a box body's shape: its cells' parts are cuboids
-  Vec3 centroid;        // of the cell points
+  Vec3 local_centroid;  // of the cell points, body frame
   double radius = 0.0;  // bounding sphere about it
-  Eigen::Matrix3d J_inverse = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d local_J_inverse = Eigen::Matrix3d::Zero();  // body frame
+  std::vector<Vec3> half;         // per cell: half extents of its solid (cell_solid)
+  std::vector<double> solid_volume;  // per cell: V of T_c
+  bool shared = false;            // corners shares the cells' corner terms
+  SharedCorners corners;
+  // At build:
+  Mat3 rotation;  // R_X
+  Vec3 centroid;  // world
+  Eigen::Matrix3d J_inverse = Eigen::Matrix3d::Zero();  // world: R_X J^-1 R_X^T
 };
 
 struct BallCellPair {
-  int ball = -1, lattice = -1;  // indices into balls_, lattices_
+  int ball = -1, lattice = -1;  // indices into balls_, cached_
   int b = -1, c = -1;           // cells
   Vec3 half;                    // half extents of the cell's cuboid (body frame)
   double volume = 0.0;          // V of T_c
   double K[6];                  // world, 1/m^3
+  Vec3 r;                       // x_b - x_c at build
+  PairGeometry geometry;        // at r, with the gradients (reused by add_forces)
 };
+
+bool same(const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+bool same(const Mat3& a, const Mat3& b) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (a.m[i][j] != b.m[i][j]) return false;
+  return true;
+}
 
 class BallLatticeNearField final : public NearFieldTerm {
  public:
@@ -196,54 +371,62 @@ class BallLatticeNearField final : public NearFieldTerm {
     lattices_.clear();
     pairs_.clear();
     if (model.intra_body_tensor() != IntraBodyTensor::cell_average) return;
+    if (model.generation() != cached_generation_ || cached_bodies_ != model.body_count()) cache_lattices(model);
     for (int bi = 0; bi < model.body_count(); ++bi) {
       const MagneticBody& body = model.body(bi);
       if (body.inert() || !state.active[bi]) continue;
-      if (body.cells.spacing <= 0.0) {
-        if (body.cell_count() == 1 && std::holds_alternative<Sphere>(body.shape))
-          balls_.push_back({body.first_cell, bi, body.cells.contact_radius});
-        continue;
-      }
-      if (body.cell_count() < 3 || body.cells.graded) continue;  // graded: point dipoles (lattice_near_field.cpp)
-      LatticeBody lb;
-      lb.body = bi;
-      lb.h = body.cells.spacing;
-      lb.volume = body.cells.cell_volume;
-      lb.box = std::get_if<Box>(&body.shape);
-      for (int i = 0; i < body.cell_count(); ++i) lb.centroid += state.cell_position[body.first_cell + i];
-      lb.centroid = lb.centroid / body.cell_count();
-      Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
-      for (int i = 0; i < body.cell_count(); ++i) {
-        const Vec3 d = state.cell_position[body.first_cell + i] - lb.centroid;
-        lb.radius = std::max(lb.radius, norm(d));
-        const Eigen::Vector3d e(d.x, d.y, d.z);
-        J += e.squaredNorm() * Eigen::Matrix3d::Identity() - e * e.transpose();
-      }
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(J);
-      if (eig.eigenvalues()(0) < kMinCoupleInertia * lb.h * lb.h) continue;  // collinear cells
-      lb.J_inverse = J.inverse();
-      lattices_.push_back(lb);
+      if (body.cells.spacing <= 0.0 && body.cell_count() == 1 && std::holds_alternative<Sphere>(body.shape))
+        balls_.push_back({body.first_cell, bi, body.cells.contact_radius});
     }
+    for (int li = 0; li < static_cast<int>(cached_.size()); ++li) {
+      const LatticeBody& lb = cached_[li];
+      if (!state.active[lb.body]) continue;
+      lattices_.push_back(li);
+      LatticeBody& l = cached_[li];
+      const BodyPose& pose = state.pose[lb.body];
+      l.rotation = pose.rotation;
+      l.centroid = pose.position + pose.rotation * lb.local_centroid;
+      Eigen::Matrix3d R;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) R(a, b) = pose.rotation.m[a][b];
+      l.J_inverse = R * lb.local_J_inverse * R.transpose();
+    }
+    std::vector<int> near;
     for (int bi = 0; bi < static_cast<int>(balls_.size()); ++bi) {
       const Ball& ball = balls_[bi];
       const Vec3& xb = state.cell_position[ball.cell];
-      for (int li = 0; li < static_cast<int>(lattices_.size()); ++li) {
-        const LatticeBody& lb = lattices_[li];
+      for (int li : lattices_) {
+        LatticeBody& lb = cached_[li];
         if (norm(xb - lb.centroid) >= lb.radius + kCutoffEnd * lb.h) continue;
         const MagneticBody& body = model.body(lb.body);
-        const Mat3& R_X = state.pose[lb.body].rotation;
-        for (int i = 0; i < body.cell_count(); ++i) {
+        const Mat3& R_X = lb.rotation;
+        if (lb.shared) {
+          const Vec3 q = R_X.transpose_times(xb - state.pose[lb.body].position);
+          lb.corners.begin(q);
+          lb.corners.cells_near(q, kCutoffEnd * lb.h, near);
+        } else {
+          near.resize(body.cell_count());
+          for (int i = 0; i < body.cell_count(); ++i) near[i] = i;
+        }
+        for (int i : near) {
           const int c = body.first_cell + i;
-          const Vec3 r = xb - state.cell_position[c];
           BallCellPair p;
-          cell_solid(model, lb, c, p.half, p.volume);
-          const PairGeometry g = pair_geometry(r, R_X, lb.h, p.half, p.volume, ball.radius, false);
-          if (g.w == 0.0) continue;
+          p.r = xb - state.cell_position[c];
+          p.half = lb.half[i];
+          p.volume = lb.solid_volume[i];
+          Vec3 l;
+          if (!pair_windows(p.r, R_X, lb.h, p.half, ball.radius, true, p.geometry, l)) continue;
+          CuboidCornerTerms t;
+          if (lb.shared)
+            lb.corners.terms(i, t);
+          else
+            cuboid_corner_terms(l, p.half, true, t);
+          pair_tensor(t, R_X, p.volume, true, p.geometry);
           p.ball = bi, p.lattice = li, p.b = ball.cell, p.c = c;
           const double s = model.cell_contact_radius(ball.cell) + model.cell_contact_radius(c);
-          double t[6];
-          dipole_tensor(r, s * s, t);
-          for (int m = 0; m < 6; ++m) p.K[m] = g.w * (g.Tc[m] - t[m]);
+          double dipole[6];
+          dipole_tensor(p.r, s * s, dipole);
+          for (int m = 0; m < 6; ++m) p.K[m] = p.geometry.w * (p.geometry.Tc[m] - dipole[m]);
           pairs_.push_back(p);
         }
       }
@@ -255,7 +438,7 @@ class BallLatticeNearField final : public NearFieldTerm {
     const bool responsive_sources = sources == NearFieldSources::responsive;
     for (const BallCellPair& p : pairs_) {
       const bool resp_b = model.body(balls_[p.ball].body).responsive();
-      const bool resp_c = model.body(lattices_[p.lattice].body).responsive();
+      const bool resp_c = model.body(cached_[p.lattice].body).responsive();
       if (resp_b && resp_c == responsive_sources) H[p.b] += symmetric_times(p.K, moment(model, state, p.c));
       if (resp_c && resp_b == responsive_sources) H[p.c] += symmetric_times(p.K, moment(model, state, p.b));
     }
@@ -263,13 +446,17 @@ class BallLatticeNearField final : public NearFieldTerm {
 
   void add_forces(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& force,
                   std::vector<Vec3>& field) const override {
-    std::vector<Vec3> torque(lattices_.size());
+    std::vector<Vec3> torque(cached_.size());
     for (const BallCellPair& p : pairs_) {
-      const LatticeBody& lb = lattices_[p.lattice];
+      const LatticeBody& lb = cached_[p.lattice];
       const Vec3 mu_b = moment(model, state, p.b), mu_c = moment(model, state, p.c);
       const Vec3 r = state.cell_position[p.b] - state.cell_position[p.c];
-      const PairGeometry g =
-          pair_geometry(r, state.pose[lb.body].rotation, lb.h, p.half, p.volume, balls_[p.ball].radius, true);
+      const Mat3& R_X = state.pose[lb.body].rotation;
+      // The geometry of build where nothing has moved since (the usual case:
+      // the backends build at begin_step and take forces at the same poses).
+      const PairGeometry g = same(r, p.r) && same(R_X, lb.rotation)
+                                 ? p.geometry
+                                 : pair_geometry(r, R_X, lb.h, p.half, p.volume, balls_[p.ball].radius, true);
       if (g.w == 0.0) continue;
       const double s = model.cell_contact_radius(p.b) + model.cell_contact_radius(p.c);
       const Vec3 Tc_mu_c = symmetric_times(g.Tc, mu_c), Tc_mu_b = symmetric_times(g.Tc, mu_b);
@@ -287,10 +474,10 @@ class BallLatticeNearField final : public NearFieldTerm {
       torque[p.lattice] -= kMu0 * (cross(r, (phi0 * g.w_out) * g.grad_w_in + g.w * g_c) +
                                    g.w * (cross(mu_b, Tc_mu_c) + cross(mu_c, Tc_mu_b)));
     }
-    for (std::size_t li = 0; li < lattices_.size(); ++li) {
+    for (int li : lattices_) {
       const Vec3& tau = torque[li];
       if (tau.x == 0.0 && tau.y == 0.0 && tau.z == 0.0) continue;
-      const LatticeBody& lb = lattices_[li];
+      const LatticeBody& lb = cached_[li];
       const Eigen::Vector3d omega = lb.J_inverse * Eigen::Vector3d(tau.x, tau.y, tau.z);
       const MagneticBody& body = model.body(lb.body);
       for (int i = 0; i < body.cell_count(); ++i) {
@@ -310,6 +497,49 @@ class BallLatticeNearField final : public NearFieldTerm {
   int pair_count() const override { return static_cast<int>(pairs_.size()); }
 
  private:
+  // The model-only data of every lattice body with at least three cells spread
+  // in three dimensions (the frame couple needs them), not graded (graded
+  // cells stay point dipoles: lattice_near_field.cpp) and not inert.
+  void cache_lattices(const MagneticModel& model) {
+    cached_.clear();
+    cached_generation_ = model.generation();
+    cached_bodies_ = model.body_count();
+    for (int bi = 0; bi < model.body_count(); ++bi) {
+      const MagneticBody& body = model.body(bi);
+      if (body.inert() || body.cells.spacing <= 0.0 || body.cell_count() < 3 || body.cells.graded) continue;
+      LatticeBody lb;
+      lb.body = bi;
+      lb.h = body.cells.spacing;
+      lb.volume = body.cells.cell_volume;
+      lb.box = std::get_if<Box>(&body.shape);
+      const std::vector<Vec3>& x = body.cells.local_positions;
+      for (const Vec3& xi : x) lb.local_centroid += xi;
+      lb.local_centroid = lb.local_centroid / body.cell_count();
+      Eigen::Matrix3d J = Eigen::Matrix3d::Zero();
+      for (const Vec3& xi : x) {
+        const Vec3 d = xi - lb.local_centroid;
+        lb.radius = std::max(lb.radius, norm(d));
+        const Eigen::Vector3d e(d.x, d.y, d.z);
+        J += e.squaredNorm() * Eigen::Matrix3d::Identity() - e * e.transpose();
+      }
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(J);
+      if (eig.eigenvalues()(0) < kMinCoupleInertia * lb.h * lb.h) continue;  // collinear cells
+      lb.local_J_inverse = J.inverse();
+      std::vector<Vec3> lower, upper;
+      for (int i = 0; i < body.cell_count(); ++i) {
+        Vec3 half;
+        double volume;
+        cell_solid(model, lb, body.first_cell + i, half, volume);
+        lb.half.push_back(half);
+        lb.solid_volume.push_back(volume);
+        lower.push_back(x[i] - half);
+        upper.push_back(x[i] + half);
+      }
+      lb.shared = lb.corners.build(lower, upper, lb.h);
+      cached_.push_back(std::move(lb));
+    }
+  }
+
   static Vec3 moment(const MagneticModel& model, const MagneticState& state, int cell) {
     return model.cell_volume(cell) * state.magnetization[cell];
   }
@@ -336,7 +566,10 @@ class BallLatticeNearField final : public NearFieldTerm {
   }
 
   std::vector<Ball> balls_;
-  std::vector<LatticeBody> lattices_;
+  std::vector<LatticeBody> cached_;  // every lattice body that can take a pair (cache_lattices)
+  uint64_t cached_generation_ = 0;
+  int cached_bodies_ = -1;
+  std::vector<int> lattices_;  // the active ones at build, indices into cached_
   std::vector<BallCellPair> pairs_;
 };
 

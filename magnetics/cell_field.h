@@ -40,50 +40,6 @@ ODEMAG_HD double corner_angle(double X, double Y, double Z) {
   return atan(Y * Z / (X * sqrt(X * X + Y * Y + Z * Z)));
 }
 
-// Demagnetising tensor N(p) of an axis-aligned cuboid of half extents
-// (a, b, c) centred at the origin: H(p) = -N(p) M. From the surface charges
-// sigma = M.n summed over the eight corners (x' = +-a, ...), sign s = sx sy sz:
-//   N_xx = -(1/4pi) sum s atan(Y Z / (X R)),  N_xy = (1/4pi) sum s log(Z + R),
-// with X = x - x', etc., and the other components by permutation.
-// N(0) = I/3 for a cube. Six components (xx, xy, xz, yy, yz, zz).
-// Points within 1e-12 of the size of a face plane count as on it (both
-// sides then take the mean, so a point on a face shared by two lattice cubes
-// gets a consistent value from each, whatever the round-off of its position).
-ODEMAG_HD void cuboid_demag_tensor(const Vec3& p, const Vec3& half, double n[6]) {
-  const double k = 1.0 / (4.0 * kPi);
-  const double eps = 1e-12 * (half.x + half.y + half.z);
-  auto snap = [eps](double v) { return fabs(v) < eps ? 0.0 : v; };
-  double xx = 0, yy = 0, zz = 0, xy = 0, xz = 0, yz = 0;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
-      for (int l = 0; l < 2; ++l) {
-        const double sx = i ? 1.0 : -1.0, sy = j ? 1.0 : -1.0, sz = l ? 1.0 : -1.0;
-        const double X = snap(p.x - sx * half.x), Y = snap(p.y - sy * half.y), Z = snap(p.z - sz * half.z);
-        const double s = sx * sy * sz;
-        xx -= s * corner_angle(X, Y, Z);
-        yy -= s * corner_angle(Y, X, Z);
-        zz -= s * corner_angle(Z, X, Y);
-      }
-  // Off-diagonal terms: the corner sums of s log(W + R) paired along W.
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) {
-      const double s1 = i ? 1.0 : -1.0, s2 = j ? 1.0 : -1.0, s = s1 * s2;
-      // xy: pairs along z, with X, Y at the corner.
-      xy += s * log_pair(snap(p.x - s1 * half.x), snap(p.y - s2 * half.y), snap(p.z + half.z),
-                         snap(p.z - half.z), eps);
-      xz += s * log_pair(snap(p.x - s1 * half.x), snap(p.z - s2 * half.z), snap(p.y + half.y),
-                         snap(p.y - half.y), eps);
-      yz += s * log_pair(snap(p.y - s1 * half.y), snap(p.z - s2 * half.z), snap(p.x + half.x),
-                         snap(p.x - half.x), eps);
-    }
-  n[0] = k * xx;
-  n[1] = k * xy;
-  n[2] = k * xz;
-  n[3] = k * yy;
-  n[4] = k * yz;
-  n[5] = k * zz;
-}
-
 // (A / R_A - B / R_B) / rho^2 with R = sqrt(rho^2 + Z^2), rho^2 = X^2 + Y^2, for
 // the two ends Z = A > B of a pair along one axis: the factor that the
 // gradient of the cuboid's tensor needs. Where A and B have the same sign (the
@@ -101,6 +57,127 @@ ODEMAG_HD double edge_ratio(double X, double Y, double A, double B, double eps) 
   return (A / RA - B / RB) / rho2;
 }
 
+// The corner terms of an axis-aligned cuboid's demagnetising tensor at a point
+// p: what cuboid_demag_tensor and cuboid_demag_gradient sum with the corners'
+// signs. Index 0 is the lower face plane of an axis (x' = -a, s = -1), 1 the
+// upper (x' = +a, s = +1); offset[k][i] = p_k - x'_k. Edges e run along one
+// axis between two face planes of the other two: e = 0 along z (x, y planes),
+// 1 along y (x, z planes), 2 along x (y, z planes). Lattices whose cells share
+// face planes compute each term once for all cells (ball_lattice_near_field.cpp).
+struct CuboidCornerTerms {
+  double offset[3][2];                // p_k - x'_k, unsnapped
+  double angle[2][2][2][3];           // corner_angle(X, Y, Z), (Y, X, Z), (Z, X, Y)
+  double inverse_distance[2][2][2];   // 1 / R (the gradient only)
+  double log_pair[3][2][2];           // log_pair along the edge
+  double edge_ratio[3][2][2];         // edge_ratio along the edge (the gradient only)
+};
+
+// The snapping distance of a cuboid's terms: points within 1e-12 of its size
+// of a face plane count as on it (cuboid_demag_tensor).
+ODEMAG_HD double cuboid_snap_distance(const Vec3& half) { return 1e-12 * (half.x + half.y + half.z); }
+
+// The three angles and 1 / R at corner offsets (X, Y, Z), unsnapped, of a
+// cuboid with snapping distance eps.
+ODEMAG_HD void cuboid_corner(double X, double Y, double Z, double eps, double angle[3], double& inverse_distance) {
+  auto snap = [eps](double v) { return fabs(v) < eps ? 0.0 : v; };
+  const double Xs = snap(X), Ys = snap(Y), Zs = snap(Z);
+  angle[0] = corner_angle(Xs, Ys, Zs);
+  angle[1] = corner_angle(Ys, Xs, Zs);
+  angle[2] = corner_angle(Zs, Xs, Ys);
+  inverse_distance = 1.0 / sqrt(fmax(X * X + Y * Y + Z * Z, eps * eps));
+}
+
+// log_pair and edge_ratio of the edge at offsets (U, W) from its two planes,
+// running from offset A (the lower plane) to B (the upper), unsnapped.
+ODEMAG_HD void cuboid_edge(double U, double W, double A, double B, double eps, double& log_term, double& ratio) {
+  auto snap = [eps](double v) { return fabs(v) < eps ? 0.0 : v; };
+  log_term = log_pair(snap(U), snap(W), snap(A), snap(B), eps);
+  ratio = edge_ratio(U, W, A, B, eps);
+}
+
+// The corner terms of the cuboid of half extents `half` centred at the
+// origin, at p (with_gradient = false leaves inverse_distance and edge_ratio
+// unset).
+ODEMAG_HD void cuboid_corner_terms(const Vec3& p, const Vec3& half, bool with_gradient, CuboidCornerTerms& t) {
+  const double eps = cuboid_snap_distance(half);
+  const double P[3] = {p.x, p.y, p.z}, H[3] = {half.x, half.y, half.z};
+  for (int k = 0; k < 3; ++k) {
+    t.offset[k][0] = P[k] + H[k];
+    t.offset[k][1] = P[k] - H[k];
+  }
+  auto snap = [eps](double v) { return fabs(v) < eps ? 0.0 : v; };
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int l = 0; l < 2; ++l) {
+        const double X = t.offset[0][i], Y = t.offset[1][j], Z = t.offset[2][l];
+        if (with_gradient) {
+          cuboid_corner(X, Y, Z, eps, t.angle[i][j][l], t.inverse_distance[i][j][l]);
+        } else {
+          const double Xs = snap(X), Ys = snap(Y), Zs = snap(Z);
+          t.angle[i][j][l][0] = corner_angle(Xs, Ys, Zs);
+          t.angle[i][j][l][1] = corner_angle(Ys, Xs, Zs);
+          t.angle[i][j][l][2] = corner_angle(Zs, Xs, Ys);
+        }
+      }
+  // Edge e runs along axis `along[e]` between planes of axes u[e], w[e].
+  constexpr int u[3] = {0, 0, 1}, w[3] = {1, 2, 2}, along[3] = {2, 1, 0};
+  for (int e = 0; e < 3; ++e)
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) {
+        const double U = t.offset[u[e]][i], W = t.offset[w[e]][j];
+        const double A = t.offset[along[e]][0], B = t.offset[along[e]][1];
+        if (with_gradient) {
+          cuboid_edge(U, W, A, B, eps, t.log_pair[e][i][j], t.edge_ratio[e][i][j]);
+        } else {
+          t.log_pair[e][i][j] = log_pair(snap(U), snap(W), snap(A), snap(B), eps);
+        }
+      }
+}
+
+// Demagnetising tensor N(p) of an axis-aligned cuboid of half extents
+// (a, b, c) centred at the origin: H(p) = -N(p) M. From the surface charges
+// sigma = M.n summed over the eight corners (x' = +-a, ...), sign s = sx sy sz:
+//   N_xx = -(1/4pi) sum s atan(Y Z / (X R)),  N_xy = (1/4pi) sum s log(Z + R),
+// with X = x - x', etc., and the other components by permutation; the logs
+// are summed in pairs along an edge (log_pair). Six components (xx, xy, xz,
+// yy, yz, zz), from the corner terms.
+ODEMAG_HD void cuboid_demag_tensor(const CuboidCornerTerms& t, double n[6]) {
+  const double k = 1.0 / (4.0 * kPi);
+  double xx = 0, yy = 0, zz = 0, xy = 0, xz = 0, yz = 0;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int l = 0; l < 2; ++l) {
+        const double s = (i ? 1.0 : -1.0) * (j ? 1.0 : -1.0) * (l ? 1.0 : -1.0);
+        xx -= s * t.angle[i][j][l][0];
+        yy -= s * t.angle[i][j][l][1];
+        zz -= s * t.angle[i][j][l][2];
+      }
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) {
+      const double s = (i ? 1.0 : -1.0) * (j ? 1.0 : -1.0);
+      xy += s * t.log_pair[0][i][j];
+      xz += s * t.log_pair[1][i][j];
+      yz += s * t.log_pair[2][i][j];
+    }
+  n[0] = k * xx;
+  n[1] = k * xy;
+  n[2] = k * xz;
+  n[3] = k * yy;
+  n[4] = k * yz;
+  n[5] = k * zz;
+}
+
+// N(p) of the cuboid of half extents `half` centred at the origin. N(0) = I/3
+// for a cube. Points within 1e-12 of the size of a face plane count as on it
+// (both sides then take the mean, so a point on a face shared by two lattice
+// cubes gets a consistent value from each, whatever the round-off of its
+// position).
+ODEMAG_HD void cuboid_demag_tensor(const Vec3& p, const Vec3& half, double n[6]) {
+  CuboidCornerTerms t;
+  cuboid_corner_terms(p, half, false, t);
+  cuboid_demag_tensor(t, n);
+}
+
 // The gradient of cuboid_demag_tensor: g[m][k] = dN_m / dp_k (m in the
 // order xx, xy, xz, yy, yz, zz). N = -grad grad psi with psi the Newtonian
 // potential of the cuboid, (1/4pi) int dV' / |p - p'|, so dN_ij / dp_k is
@@ -114,24 +191,21 @@ ODEMAG_HD double edge_ratio(double X, double Y, double A, double B, double eps) 
 // first term cancels between the two ends), and the other pairs by
 // permutation. Valid off the cuboid's surface; singular on its edges (like
 // N's off-diagonal logs) and, as the field's normal component jumps there,
-// meaningless on its faces.
-ODEMAG_HD void cuboid_demag_gradient(const Vec3& p, const Vec3& half, double g[6][3]) {
+// meaningless on its faces. From corner terms computed with the gradient.
+ODEMAG_HD void cuboid_demag_gradient(const CuboidCornerTerms& t, double g[6][3]) {
   const double k = 1.0 / (4.0 * kPi);
-  const double eps = 1e-12 * (half.x + half.y + half.z);
-  const double P[3] = {p.x, p.y, p.z}, H[3] = {half.x, half.y, half.z};
   // d[o][r] = dN_rr / dp_o = dN_ro / dp_r for o != r (the symmetry above).
   double d[3][3] = {};
   for (int i = 0; i < 3; ++i)
     for (int j = i + 1; j < 3; ++j) {
-      const int l = 3 - i - j;  // the axis the pair runs along
+      const int e = i + j - 1;  // the edge index of the pair (0: xy along z, 1: xz along y, 2: yz along x)
       double di = 0.0, dj = 0.0;
       for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b) {
           const double si = a ? 1.0 : -1.0, sj = b ? 1.0 : -1.0;
-          const double Xi = P[i] - si * H[i], Xj = P[j] - sj * H[j];
-          const double e = edge_ratio(Xi, Xj, P[l] + H[l], P[l] - H[l], eps);
-          di += si * sj * Xi * e;
-          dj += si * sj * Xj * e;
+          const double r = t.edge_ratio[e][a][b];
+          di += si * sj * t.offset[i][a] * r;
+          dj += si * sj * t.offset[j][b] * r;
         }
       d[i][j] = k * dj;  // dN_ij / dp_j = dN_jj / dp_i
       d[j][i] = k * di;  // dN_ij / dp_i = dN_ii / dp_j
@@ -139,11 +213,8 @@ ODEMAG_HD void cuboid_demag_gradient(const Vec3& p, const Vec3& half, double g[6
   double xyz = 0.0;
   for (int a = 0; a < 2; ++a)
     for (int b = 0; b < 2; ++b)
-      for (int c = 0; c < 2; ++c) {
-        const double sx = a ? 1.0 : -1.0, sy = b ? 1.0 : -1.0, sz = c ? 1.0 : -1.0;
-        const double X = P[0] - sx * H[0], Y = P[1] - sy * H[1], Z = P[2] - sz * H[2];
-        xyz += sx * sy * sz / sqrt(fmax(X * X + Y * Y + Z * Z, eps * eps));
-      }
+      for (int c = 0; c < 2; ++c)
+        xyz += (a ? 1.0 : -1.0) * (b ? 1.0 : -1.0) * (c ? 1.0 : -1.0) * t.inverse_distance[a][b][c];
   xyz *= k;
   // G(i, j, l) = dN_ij / dp_l, fully symmetric.
   auto G = [&](int i, int j, int l) {
@@ -161,6 +232,12 @@ ODEMAG_HD void cuboid_demag_gradient(const Vec3& p, const Vec3& half, double g[6
   constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
   for (int m = 0; m < 6; ++m)
     for (int l = 0; l < 3; ++l) g[m][l] = G(row[m], col[m], l);
+}
+
+ODEMAG_HD void cuboid_demag_gradient(const Vec3& p, const Vec3& half, double g[6][3]) {
+  CuboidCornerTerms t;
+  cuboid_corner_terms(p, half, true, t);
+  cuboid_demag_gradient(t, g);
 }
 
 // H (A/m) at p (cuboid frame) of an axis-aligned cuboid with magnetization M.

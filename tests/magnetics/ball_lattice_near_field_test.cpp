@@ -209,6 +209,36 @@ TEST(BallLatticeNearField, PermanentBallHasTheBoxsForceAndTorque) {
   EXPECT_LT(worst_torque, 2e-3);
 }
 
+// A 40 mm cube of 2 x 2 x 2 cells and a permanent ball close enough that
+// every cell is inside the full window (centre distances < 2 h, the ball's
+// centre more than 0.75 R from each cube): the cells' cubes then add up to the
+// whole box, so force and field on the ball are the box's closed form (one
+// cuboid: cuboid_demag_tensor / cuboid_demag_gradient of the box, checked
+// against the quadrature above) to round-off. This pins the cells' shared
+// corner and edge terms (each computed once for the cells that meet there)
+// and the geometry that add_forces reuses from build.
+TEST(BallLatticeNearField, CellsInTheFullWindowAddUpToTheBox) {
+  const Vec3 cube{0.04, 0.04, 0.04};
+  const Vec3 Mb = 1e5 * normalized(Vec3{0.3, 0.5, -0.8});
+  const Vec3 mu = (4.0 / 3.0) * kPi * kR * kR * kR * Mb;
+  for (const Vec3& x : {Vec3{0.002, -0.001, 0.026}, Vec3{0.026, 0.001, -0.002}, Vec3{-0.0015, 0.026, 0.0005}}) {
+    BallAndMagnet p = ball_and_magnet(x, Mb, 0.0, cube);
+    magnetic_forces_at_held_magnetization(p.model, p.state, tight(true), *p.backend);
+    double n[6], dn[6][3];
+    cuboid_demag_tensor(x, 0.5 * cube, n);
+    cuboid_demag_gradient(x, 0.5 * cube, dn);
+    const Vec3 H = -1.0 * symmetric_times(n, kMagnetM);
+    Vec3 F_ref;  // F_k = mu0 mu_i dH_i/dx_k, dH_i/dx_k = -dN_ij/dx_k M_j
+    for (int k = 0; k < 3; ++k) {
+      double g[6];
+      for (int m = 0; m < 6; ++m) g[m] = dn[m][k];
+      F_ref[k] = -kMu0 * dot(mu, symmetric_times(g, kMagnetM));
+    }
+    EXPECT_LT(rel(p.state.force[1], F_ref), 1e-10) << x.x << " " << x.y << " " << x.z;
+    EXPECT_LT(rel(p.state.torque[1], kMu0 * cross(mu, H)), 1e-10);
+  }
+}
+
 // A permanent plate thinner than a cell (60 x 60 x 5 mm, h = 20 mm: one
 // layer of partial cells, each a cuboid of 20 x 20 x 5 mm) and a permanent
 // ball on it, above a cell's centre, a lattice vertex and the plate's edge.
