@@ -20,8 +20,10 @@ std::string validate_one(const InertMaterial&) { return {}; }
 
 std::string validate_one(const PermanentMaterial& m) {
   if (!finite(m.magnetization)) return "magnetization must be finite";
-  if (!std::isfinite(m.recoil_susceptibility) || m.recoil_susceptibility < 0.0)
-    return "recoil_susceptibility must be finite and >= 0";
+  if (!std::isfinite(m.recoil_susceptibility) || m.recoil_susceptibility < -1.0)
+    return "recoil_susceptibility must be finite and >= -1";
+  if (m.recoil_susceptibility < 0.0 && (m.magnetization.x != 0.0 || m.magnetization.y != 0.0 || m.magnetization.z != 0.0))
+    return "a negative recoil_susceptibility (a diamagnet) needs magnetization 0";
   return {};
 }
 

@@ -14,7 +14,9 @@ namespace odemag {
 // susceptibility chi_r so that M = M_r + chi_r * H_inside.
 struct PermanentMaterial {
   Vec3 magnetization;                 // M_r, A/m, body frame
-  double recoil_susceptibility = 0.0;  // chi_r, dimensionless, >= 0
+  // chi_r, dimensionless, >= -1; below 0 a diamagnet (magnetization 0): -1 a
+  // perfect one (a superconductor in the Meissner state, as a linear medium)
+  double recoil_susceptibility = 0.0;
 };
 
 // Ferromagnet magnetized by the field: n unit moments per cell evolved by LLG.

@@ -207,7 +207,7 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
   if (const auto* pm = std::get_if<PermanentMaterial>(&material)) {
     body.remanence = pm->magnetization;
     body.recoil = pm->recoil_susceptibility;
-    body.kind = pm->recoil_susceptibility > 0.0 ? CellKind::recoil_permanent : CellKind::fixed_permanent;
+    body.kind = pm->recoil_susceptibility != 0.0 ? CellKind::recoil_permanent : CellKind::fixed_permanent;
   } else if (const auto* sm = std::get_if<SoftMaterial>(&material)) {
     body.kind = CellKind::soft;
     body.soft.Ms = sm->saturation;
@@ -222,7 +222,9 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     build_pair_tensors(body);
   } else if (body.responsive() && body.cell_count() > 1) {
     build_offset_tensors(body, intra_tensor_);
-    if (!body.cells.whole_cells && intra_tensor_ == IntraBodyTensor::cell_average) build_boundary_correction(body);
+    // Diamagnets (recoil < 0) take none: its update needs N + 1/chi positive definite.
+    if (!body.cells.whole_cells && intra_tensor_ == IntraBodyTensor::cell_average && body.recoil >= 0.0)
+      build_boundary_correction(body);
   }
 
   for (int c = 0; c < body.cell_count(); ++c) {
@@ -239,6 +241,16 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
   bodies_.push_back(std::move(body));
   generation_.bump();
   return body_count() - 1;
+}
+
+void MagneticModel::add_coil(int body, const CoilSource& source) {
+  if (body < 0 || body >= body_count())
+    throw std::invalid_argument("MagneticModel::add_coil: no body " + std::to_string(body) + " (the model has " +
+                                std::to_string(body_count()) + ")");
+  if (const std::string e = coil_source_error(source); !e.empty())
+    throw std::invalid_argument("MagneticModel::add_coil: body " + bodies_[body].name + ": " + e);
+  coils_.push_back({body, source});
+  generation_.bump();
 }
 
 int MagneticModel::find_body(const std::string& name) const {

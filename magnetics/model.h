@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "magnetics/cells.h"
+#include "magnetics/coil.h"
 #include "magnetics/demag_tensor.h"
 #include "magnetics/llg.h"
 #include "magnetics/material.h"
@@ -117,6 +118,17 @@ class ModelGeneration {
   uint64_t value_;
 };
 
+// A current source carried by a body (magnetics/coil.h), given in the body
+// frame: it moves with the body, its current is multiplied by the body's
+// MagneticState::magnetization_scale, its field acts on every active
+// responsive cell (its own body's too: a coil around a core) and its force on
+// the cells of other bodies returns to the carrying body (docs/model.md
+// "Coils in a scene").
+struct AttachedCoil {
+  int body = -1;
+  CoilSource source;
+};
+
 class MagneticModel {
  public:
   MagneticModel() = default;
@@ -141,6 +153,11 @@ class MagneticModel {
   // checked before any cell is made).
   int add_body(const std::string& name, const Shape& shape, const Material& material,
                double cell_size);
+
+  // Attaches a current source to body `body` (body frame). Throws
+  // std::invalid_argument on a bad index or geometry (coil_source_error).
+  void add_coil(int body, const CoilSource& source);
+  const std::vector<AttachedCoil>& coils() const { return coils_; }
 
   const std::vector<MagneticBody>& bodies() const { return bodies_; }
   const MagneticBody& body(int b) const { return bodies_[b]; }
@@ -169,6 +186,7 @@ class MagneticModel {
   IntraBodyTensor intra_tensor_ = IntraBodyTensor::cell_average;
   bool graded_cells_ = false;
   std::vector<MagneticBody> bodies_;
+  std::vector<AttachedCoil> coils_;
   std::vector<int> cell_body_;
   std::vector<int> moment_offset_;
   int moment_count_ = 0;

@@ -30,6 +30,12 @@ double cell_field_scale(const MagneticModel& model, const MagneticState& state, 
   return norm(H_A) + gamma * norm(state.magnetization[c]);
 }
 
+bool carries_coil(const MagneticModel& model, int b) {
+  for (const AttachedCoil& k : model.coils())
+    if (k.body == b) return true;
+  return false;
+}
+
 bool unchanged_since_last_solve(const MagneticModel& model, const MagneticState& state, const RelaxOptions& o) {
   const SolvedInputs& last = state.last_solve;
   const size_t bodies = static_cast<size_t>(model.body_count());
@@ -39,7 +45,7 @@ bool unchanged_since_last_solve(const MagneticModel& model, const MagneticState&
     return false;
   for (int b = 0; b < model.body_count(); ++b) {
     const MagneticBody& body = model.body(b);
-    if (body.inert() || !state.active[b]) continue;
+    if ((body.inert() && !carries_coil(model, b)) || !state.active[b]) continue;
     const BodyPose &p = state.pose[b], &q = last.pose[b];
     if (norm(p.position - q.position) > kUnchangedDistance * body.cells.contact_radius) return false;
     for (int i = 0; i < 3; ++i)
@@ -65,14 +71,66 @@ void record_solve(MagneticState& state, const RelaxOptions& o, bool converged) {
 // drops a NaN second argument). Equal to std::max(a, b) otherwise.
 double max_keeping_nan(double a, double b) { return b > a || std::isnan(b) ? b : a; }
 
-// Electromagnets: the (scaled) coil field acts on the cells of its own core.
+// H (A/m) at world point x of the model's coils (AttachedCoil) that are
+// carried by an active body other than `skip_body`, each at its body's pose,
+// its current times the body's magnetization_scale.
+Vec3 attached_coil_field(const MagneticModel& model, const MagneticState& state, const Vec3& x, int skip_body) {
+  Vec3 H;
+  for (const AttachedCoil& k : model.coils()) {
+    const double scale = state.magnetization_scale[k.body];
+    if (k.body == skip_body || !state.active[k.body] || scale == 0.0) continue;
+    const BodyPose& pose = state.pose[k.body];
+    H += scale * coil_field_H(k.source, pose.rotation, pose.position, x);
+  }
+  return H;
+}
+
+// Electromagnets: the (scaled) coil field of a soft body's material acts on the
+// cells of its own core; attached coils act on every responsive cell.
 void add_coil_fields(const MagneticModel& model, const MagneticState& state, const std::vector<int>& cells,
                      std::vector<Vec3>& H) {
+  const bool coils = !model.coils().empty();
   for (int c : cells) {
     const int b = model.cell_body(c);
     const Vec3& coil = model.body(b).coil_field;
     if (coil.x != 0.0 || coil.y != 0.0 || coil.z != 0.0)
       H[c] += state.pose[b].rotation * (state.magnetization_scale[b] * coil);
+    if (coils) H[c] += attached_coil_field(model, state, state.cell_position[c], -1);
+  }
+}
+
+// Forces of attached coils on the cells of other bodies, F = mu0 grad(mu . H)
+// = mu0 (grad H)^T mu (curl-free off the conductors), and torque mu0 mu x H;
+// the carrying body takes minus both (about its own position), so momentum
+// and angular momentum are conserved. grad H by central differences of the
+// closed forms, step 1e-4 of the cell's contact radius (truncation ~1e-8,
+// round-off ~1e-12 relative).
+void add_coil_forces(const MagneticModel& model, MagneticState& state) {
+  if (model.coils().empty()) return;
+  for (int c = 0; c < model.cell_count(); ++c) {
+    const int b = model.cell_body(c);
+    if (!state.active[b]) continue;
+    const Vec3 mu = model.cell_volume(c) * state.magnetization[c];
+    if (mu.x == 0.0 && mu.y == 0.0 && mu.z == 0.0) continue;
+    const Vec3& x = state.cell_position[c];
+    const double step = 1e-4 * std::max(model.cell_contact_radius(c), 1e-9);
+    for (const AttachedCoil& k : model.coils()) {
+      const double scale = state.magnetization_scale[k.body];
+      if (k.body == b || !state.active[k.body] || scale == 0.0) continue;
+      const BodyPose& pose = state.pose[k.body];
+      auto H_at = [&](const Vec3& p) { return scale * coil_field_H(k.source, pose.rotation, pose.position, p); };
+      Vec3 F;
+      for (int j = 0; j < 3; ++j) {
+        Vec3 e;
+        e[j] = step;
+        F[j] = kMu0 * dot(mu, H_at(x + e) - H_at(x - e)) / (2.0 * step);
+      }
+      const Vec3 tau_mu = kMu0 * cross(mu, H_at(x));
+      state.force[b] += F;
+      state.torque[b] += cross(x - state.pose[b].position, F) + tau_mu;
+      state.force[k.body] -= F;
+      state.torque[k.body] -= cross(x - pose.position, F) + tau_mu;
+    }
   }
 }
 
@@ -367,6 +425,7 @@ RelaxReport solve(const MagneticModel& model, MagneticState& state, const RelaxO
 // docs/architecture.md "One magnetic step", 4: per-body forces and torques.
 void compute_forces(const MagneticModel& model, MagneticState& state, MagneticBackend& backend) {
   backend.forces(model, state);
+  add_coil_forces(model, state);
 }
 
 // docs/architecture.md "One magnetic step", 5: remember what was solved, for the skip check.
@@ -412,6 +471,8 @@ void field_at_points(const MagneticModel& model, const MagneticState& state,
                      MagneticBackend& backend, const std::vector<Vec3>& points,
                      std::vector<Vec3>& B, std::vector<Vec3>& H) {
   backend.probe_field(model, state, points, H);
+  if (!model.coils().empty())
+    for (size_t p = 0; p < points.size(); ++p) H[p] += attached_coil_field(model, state, points[p], -1);
   B.resize(points.size());
   for (size_t p = 0; p < points.size(); ++p) {
     Vec3 M;
@@ -445,6 +506,7 @@ double magnetic_energy(const MagneticModel& model, const MagneticState& state, b
     const MagneticBody& body_a = model.body(ba);
     const Vec3 mu_a = model.cell_volume(a) * state.magnetization[a];
     e -= kMu0 * dot(mu_a, state.external_field);
+    if (!model.coils().empty()) e -= kMu0 * dot(mu_a, attached_coil_field(model, state, state.cell_position[a], ba));
     for (int b = a + 1; b < n; ++b) {
       const int bb = model.cell_body(b);
       if (!state.active[bb]) continue;

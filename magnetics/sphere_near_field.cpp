@@ -57,6 +57,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -75,6 +76,12 @@ constexpr double kTaperStart = 3.0;     // x = d / (R_a + R_b) where the taper b
 constexpr double kCutoff = 4.0;         // x beyond which a pair has no correction
 constexpr double kInsideFade = 0.1;     // overlap (of R_a + R_b) over which K fades to 0
 constexpr int kKnots = 160;             // spline knots on [1, kCutoff]
+
+// The susceptibility of a sphere without induced higher orders (a rigid
+// magnet, a one-cell box or cylinder); linear spheres have chi >= -1 (below 0:
+// diamagnets, whose gamma_l are negative).
+constexpr double kRigid = -std::numeric_limits<double>::infinity();
+bool rigid(double chi) { return chi == kRigid; }
 
 // gamma_l of a linear sphere; chi = infinity gives 1.
 double multipole_factor(int l, double chi) {
@@ -124,8 +131,8 @@ Reaction solve_pair(const PairType& type, double x) {
     auto A_ba = [&](int k, int l) { return A_ba_table(k, l); };
     std::vector<double> ga(L + 1, 0.0), gb(L + 1, 0.0);
     for (int l = 2; l <= L; ++l) {
-      ga[l] = type.chi_a < 0 ? 0.0 : multipole_factor(l, type.chi_a);
-      gb[l] = type.chi_b < 0 ? 0.0 : multipole_factor(l, type.chi_b);
+      ga[l] = rigid(type.chi_a) ? 0.0 : multipole_factor(l, type.chi_a);
+      gb[l] = rigid(type.chi_b) ? 0.0 : multipole_factor(l, type.chi_b);
     }
     // Unknowns [e_a[2..L], e_b[2..L]]; rows: e + gamma sum A e_partner = -gamma A e_partner[1].
     Eigen::MatrixXd S = Eigen::MatrixXd::Identity(2 * n, 2 * n);
@@ -145,7 +152,7 @@ Reaction solve_pair(const PairType& type, double x) {
       // contact point z = +-R, H_z = -sum_l l c_l (+-R)^(l-1), M = chi H.
       // chi (1 - gamma_l) = chi (2l + 1) / (l chi + 2l + 1), finite for chi = inf.
       auto chi_rest = [](int l, double chi) {
-        if (chi < 0) return 0.0;
+        if (rigid(chi)) return 0.0;
         return std::isinf(chi) ? (2.0 * l + 1.0) / l : chi * (2.0 * l + 1.0) / (l * chi + 2.0 * l + 1.0);
       };
       for (int col = 0; col < 2; ++col) {
@@ -325,17 +332,17 @@ std::shared_ptr<const PairTable> pair_table(const PairType& type) {
 }
 
 // How a one-cell body takes part: radius and susceptibility of its higher
-// orders (negative: rigid), and what the per-iteration sums read of its body.
+// orders (kRigid: none), and what the per-iteration sums read of its body.
 struct SphereCell {
   int cell = -1;
   double radius = 0.0;
-  double chi = -1.0;
+  double chi = kRigid;
   double volume = 0.0;       // of the cell: the dipole is volume * M
   bool responsive = false;
   bool saturates = false;    // a soft sphere: saturation_factor limits it at Ms
   double Ms = 0.0;
   int type = 0;              // index of its (radius, chi) among the spheres'
-  bool multipoles() const { return chi >= 0.0; }
+  bool multipoles() const { return !rigid(chi); }
 };
 
 struct SpherePair {

@@ -68,6 +68,10 @@ constexpr Magnitude kSpeed{1e8, "m/s"};
 constexpr Magnitude kAngularSpeed{1e8, "rad/s"};
 constexpr Magnitude kAcceleration{1e6, "m/s^2"};
 constexpr Magnitude kDensity{1e6, "kg/m^3"};
+constexpr Magnitude kCurrent{1e9, "A"};      // a coil's current; its ampere-turns N I are bounded by kAmpereTurns too
+constexpr Magnitude kAmpereTurns{1e9, "A"};  // |N I| of a coil: fields up to about kFieldStrength
+constexpr Magnitude kTurns{1e9, ""};
+constexpr Magnitude kAngle{1e6, "rad"};
 // A shape's radius, side or length is at least this (its volume must not
 // underflow to a zero moment), m.
 constexpr double kMinSize = 1e-9;
@@ -551,6 +555,16 @@ const KeyTable<MaterialTarget<SoftMaterial>> kSoftKeys = {
      .doc = {"[r, g, b]", "", "material default"}},
 };
 
+// A linear medium, M = chi H (diamagnets down to a superconductor's -1,
+// paramagnets): a recoil cell with M_r = 0 (docs/model.md "Diamagnets").
+const KeyTable<MaterialTarget<PermanentMaterial>> kLinearKeys = {
+    {.name = "type", .read = kReadBefore, .required = true, .doc = {"string", "", "**required**"}},
+    {.name = "susceptibility", .check = Check::in_range, .slot = SLOT(material.recoil_susceptibility), .lo = -1.0,
+     .hi = 1e6, .required = true, .doc = {"number", "", "**required**"}},
+    {.name = "color", .check = Check::color, .slot = SLOT(color),
+     .doc = {"[r, g, b]", "", "material default"}},
+};
+
 const KeyTable<MaterialTarget<InertMaterial>> kInertKeys = {
     {.name = "type", .read = kReadBefore, .required = true, .doc = {"string", "", "**required**"}},
     {.name = "color", .check = Check::color, .slot = SLOT(color),
@@ -571,14 +585,116 @@ Material read_material(const SceneReader& r, const json& v, const std::string& p
                        std::optional<std::array<double, 3>>& color) {
   r.require_object(v, path);
   const std::string type =
-      r.choice(r.required(v, "type", path), member(path, "type"), {"permanent", "soft", "inert"});
+      r.choice(r.required(v, "type", path), member(path, "type"), {"permanent", "soft", "linear", "inert"});
   const Material material = type == "permanent" ? read_material_keys(r, v, path, kPermanentKeys, color)
+                            : type == "linear"  ? read_material_keys(r, v, path, kLinearKeys, color)
                             : type == "soft"    ? read_material_keys(r, v, path, kSoftKeys, color)
                                                 : read_material_keys(r, v, path, kInertKeys, color);
   // The physics checks of the magnetics library, as a backstop.
   if (const std::string e = validate_material(material); !e.empty())
     r.fail(member(path, material_message_key(e)), e);
   return material;
+}
+
+
+// ---- coils (current sources carried by a body) --------------------------------------
+
+template <class S>
+struct CoilTarget {
+  S source;
+};
+
+#define COIL_TYPE {.name = "type", .read = kReadBefore, .required = true}
+#define COIL_CENTRE {.name = "centre", .check = Check::vec3, .slot = SLOT(source.centre), .bound = kLength}
+#define COIL_AXIS {.name = "axis", .check = Check::non_zero_vec3, .slot = SLOT(source.axis)}
+#define COIL_CURRENT {.name = "current", .check = Check::number, .slot = SLOT(source.current), .bound = kCurrent, .required = true}
+#define COIL_TURNS {.name = "turns", .check = Check::positive, .slot = SLOT(source.turns), .bound = kTurns}
+#define COIL_SIZE(key, field)                                                                       \
+  {.name = key, .read = [](const SceneReader& r, const json& x, const std::string& p, auto& t) { \
+     t.source.field = r.size(x, p);                                                                \
+   },                                                                                              \
+   .required = true}
+#define COIL_QUADRATURE \
+  {.name = "quadrature_order", .check = Check::integer, .slot = SLOT(source.quadrature_order), .lo = 1, .hi = 64}
+
+const KeyTable<CoilTarget<CircularLoop>> kLoopKeys = {COIL_TYPE, COIL_CENTRE, COIL_AXIS, COIL_SIZE("radius", radius),
+                                                      COIL_CURRENT, COIL_TURNS};
+const KeyTable<CoilTarget<Solenoid>> kSolenoidKeys = {
+    COIL_TYPE, COIL_CENTRE, COIL_AXIS, COIL_SIZE("radius", radius),
+    {.name = "length", .check = Check::non_negative, .slot = SLOT(source.length), .bound = kLength, .required = true},
+    COIL_CURRENT, COIL_TURNS};
+const KeyTable<CoilTarget<CircularCoil>> kCircularCoilKeys = {
+    COIL_TYPE,
+    COIL_CENTRE,
+    COIL_AXIS,
+    {.name = "inner_radius", .check = Check::non_negative, .slot = SLOT(source.inner_radius), .bound = kLength,
+     .required = true},
+    COIL_SIZE("outer_radius", outer_radius),
+    COIL_SIZE("length", length),
+    COIL_CURRENT,
+    COIL_TURNS,
+    COIL_QUADRATURE};
+const KeyTable<CoilTarget<RoundedRectangleCoil>> kRoundedRectangleKeys = {
+    COIL_TYPE,
+    COIL_CENTRE,
+    COIL_AXIS,
+    {.name = "width_direction", .check = Check::non_zero_vec3, .slot = SLOT(source.width_direction)},
+    COIL_SIZE("core_half_width", core_half_width),
+    COIL_SIZE("core_half_depth", core_half_depth),
+    {.name = "inner_corner_radius", .check = Check::non_negative, .slot = SLOT(source.inner_corner_radius),
+     .bound = kLength},
+    COIL_SIZE("outer_corner_radius", outer_corner_radius),
+    COIL_SIZE("height", height),
+    COIL_CURRENT,
+    COIL_TURNS,
+    COIL_QUADRATURE};
+const KeyTable<CoilTarget<StraightSegment>> kSegmentKeys = {
+    COIL_TYPE,
+    {.name = "a", .check = Check::vec3, .slot = SLOT(source.a), .bound = kLength, .required = true},
+    {.name = "b", .check = Check::vec3, .slot = SLOT(source.b), .bound = kLength, .required = true},
+    COIL_CURRENT,
+    COIL_TURNS};
+const KeyTable<CoilTarget<Arc>> kArcKeys = {
+    COIL_TYPE,
+    COIL_CENTRE,
+    COIL_AXIS,
+    COIL_SIZE("radius", radius),
+    {.name = "start", .check = Check::non_zero_vec3, .slot = SLOT(source.start)},
+    {.name = "angle", .check = Check::number, .slot = SLOT(source.angle), .bound = kAngle, .required = true},
+    COIL_CURRENT,
+    COIL_TURNS};
+
+#undef COIL_TYPE
+#undef COIL_CENTRE
+#undef COIL_AXIS
+#undef COIL_CURRENT
+#undef COIL_TURNS
+#undef COIL_SIZE
+#undef COIL_QUADRATURE
+
+template <class S>
+CoilSource read_coil_keys(const SceneReader& r, const json& v, const std::string& path,
+                          const KeyTable<CoilTarget<S>>& table) {
+  CoilTarget<S> t;
+  read_object(r, v, path, table, t);
+  return t.source;
+}
+
+CoilSource read_coil(const SceneReader& r, const json& v, const std::string& path) {
+  r.require_object(v, path);
+  const std::string type = r.choice(r.required(v, "type", path), member(path, "type"),
+                                    {"loop", "solenoid", "circular_coil", "rounded_rectangle", "segment", "arc"});
+  const CoilSource coil = type == "loop"                ? read_coil_keys(r, v, path, kLoopKeys)
+                          : type == "solenoid"          ? read_coil_keys(r, v, path, kSolenoidKeys)
+                          : type == "circular_coil"     ? read_coil_keys(r, v, path, kCircularCoilKeys)
+                          : type == "rounded_rectangle" ? read_coil_keys(r, v, path, kRoundedRectangleKeys)
+                          : type == "segment"           ? read_coil_keys(r, v, path, kSegmentKeys)
+                                                        : read_coil_keys(r, v, path, kArcKeys);
+  if (const std::string e = coil_source_error(coil); !e.empty()) r.fail(path, e);
+  if (std::abs(ampere_turns(coil)) > kAmpereTurns.max)
+    r.fail(member(path, "current"), "the ampere-turns current x turns = " + format_number(ampere_turns(coil)) +
+                                        " A exceed the largest accepted, " + format_number(kAmpereTurns.max) + " A");
+  return coil;
 }
 
 // ---- bodies -----------------------------------------------------------------------
@@ -674,6 +790,12 @@ const KeyTable<BodyTarget> kBodyKeys = {
      .doc = {"bool", "", "`true`"}},
     {.name = "color", .check = Check::color, .slot = SLOT(body.color),
      .doc = {"[r, g, b]", "", "material colour"}},
+    {.name = "coils",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, BodyTarget& t) {
+       if (!x.is_array()) r.fail(p, "must be an array of coil objects");
+       for (size_t i = 0; i < x.size(); ++i) t.body.coils.push_back(read_coil(r, x[i], element(p, i)));
+     },
+     .doc = {"array", "body frame", "`[]`"}},
 };
 
 BodyDescription read_body(const SceneReader& r, const json& v, const std::string& path,
@@ -960,10 +1082,10 @@ const KeyTable<EventTarget> kScaleEventKeys = {
        read_event_body(r, x, p, t);
        const Material& material = t.scene.materials.at(t.body->material);
        const SoftMaterial* soft = std::get_if<SoftMaterial>(&material);
-       const bool electromagnet = soft && norm(soft->coil_field) > 0.0;
+       const bool electromagnet = (soft && norm(soft->coil_field) > 0.0) || !t.body->coils.empty();
        if (!std::holds_alternative<PermanentMaterial>(material) && !electromagnet)
          r.fail(p, "body " + as_literal(t.e.body) + " is neither a permanent magnet nor an electromagnet (material " +
-                       as_literal(t.body->material) + ")");
+                       as_literal(t.body->material) + ", no coils)");
      },
      .required = true},
     {.name = "to",
@@ -972,11 +1094,19 @@ const KeyTable<EventTarget> kScaleEventKeys = {
        // The scaled magnetization (or coil field) stays within kFieldStrength.
        const Material& material = t.scene.materials.at(t.body->material);
        const PermanentMaterial* permanent = std::get_if<PermanentMaterial>(&material);
-       const Vec3 scaled = permanent ? permanent->magnetization : std::get<SoftMaterial>(material).coil_field;
+       const SoftMaterial* soft = std::get_if<SoftMaterial>(&material);
+       const Vec3 scaled = permanent ? permanent->magnetization : soft ? soft->coil_field : Vec3{};
        const double largest = std::max({std::abs(scaled.x), std::abs(scaled.y), std::abs(scaled.z)});
-       if (std::abs(t.e.value) > kFieldStrength.max / largest)
+       if (largest > 0.0 && std::abs(t.e.value) > kFieldStrength.max / largest)
          r.fail(p, "scales the magnetization beyond the largest accepted, " + format_number(kFieldStrength.max) +
                        " A/m (at most " + format_number(kFieldStrength.max / largest) + " for this body)");
+       // The scaled currents stay within kAmpereTurns.
+       for (const CoilSource& coil : t.body->coils) {
+         const double NI = std::abs(ampere_turns(coil));
+         if (std::abs(t.e.value) > kAmpereTurns.max / NI)
+           r.fail(p, "scales a coil's ampere-turns beyond the largest accepted, " + format_number(kAmpereTurns.max) +
+                         " A (at most " + format_number(kAmpereTurns.max / NI) + " for this body)");
+       }
      },
      .required = true},
     kEventEndTime,
@@ -1302,11 +1432,18 @@ std::vector<SceneKeyDoc> scene_key_docs() {
   std::vector<SceneKeyDoc> docs;
   add_key_docs(docs, "", kSceneKeys);
   add_key_docs(docs, "materials.permanent", kPermanentKeys);
+  add_key_docs(docs, "materials.linear", kLinearKeys);
   add_key_docs(docs, "materials.soft", kSoftKeys);
   add_key_docs(docs, "materials.inert", kInertKeys);
   add_key_docs(docs, "bodies[]", kBodyKeys);
   add_key_docs(docs, "bodies[].shape", kShapeKeys);
   add_key_docs(docs, "bodies[].shape.cylinder", kCylinderKeys);
+  add_key_docs(docs, "bodies[].coils[].loop", kLoopKeys);
+  add_key_docs(docs, "bodies[].coils[].solenoid", kSolenoidKeys);
+  add_key_docs(docs, "bodies[].coils[].circular_coil", kCircularCoilKeys);
+  add_key_docs(docs, "bodies[].coils[].rounded_rectangle", kRoundedRectangleKeys);
+  add_key_docs(docs, "bodies[].coils[].segment", kSegmentKeys);
+  add_key_docs(docs, "bodies[].coils[].arc", kArcKeys);
   add_key_docs(docs, "joints[]", kJointKeys);
   add_key_docs(docs, "solver", kSolverKeys);
   add_key_docs(docs, "simulation", kSimulationKeys);

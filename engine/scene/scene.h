@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "magnetics/coil.h"
 #include "magnetics/material.h"
 #include "magnetics/relax.h"
 #include "magnetics/shape.h"
@@ -47,6 +48,7 @@ struct BodyDescription {
   std::optional<double> cell_size;  // overrides the scene's cell_size
   bool present = true;              // false: added later by an "add" event
   std::optional<std::array<double, 3>> color;  // RGB 0..1, overrides the material colour
+  std::vector<CoilSource> coils;    // current sources carried by the body, body frame (MagneticModel::add_coil)
 };
 
 // An ODE joint between two bodies, or between one body and the world

@@ -26,7 +26,9 @@ MagneticSystem build_magnetic_system(const SceneDescription& scene) {
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "].material",
                        "unknown material \"" + body.material + "\"");
     try {
-      ms.model.add_body(body.name, body.shape, material->second, scene.body_cell_size(static_cast<int>(b)));
+      const int index =
+          ms.model.add_body(body.name, body.shape, material->second, scene.body_cell_size(static_cast<int>(b)));
+      for (const CoilSource& coil : body.coils) ms.model.add_coil(index, coil);
     } catch (const std::invalid_argument& e) {
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
     }

@@ -104,7 +104,7 @@ std::vector<SceneKeyDoc> keys_of(const std::string& section) {
 
 // The objects whose keys the docs list in a table "| key | type | ..." under a heading.
 const std::map<std::string, std::string> kKeyTables = {
-    {"", "Top level"},           {"materials.permanent", "permanent"}, {"materials.soft", "soft"},
+    {"", "Top level"},           {"materials.permanent", "permanent"}, {"materials.soft", "soft"}, {"materials.linear", "linear"},
     {"materials.inert", "inert"}, {"bodies[]", "Bodies"},              {"solver", "solver"},
     {"simulation", "simulation"}, {"simulation.contact", "contact"},   {"camera", "camera"},
     {"render", "render"},         {"outcomes[]", "outcomes"},           {"joints[]", "joints"},
@@ -113,6 +113,12 @@ const std::map<std::string, std::string> kKeyTables = {
 const std::map<std::string, std::string> kProse = {
     {"bodies[].shape", "Bodies"},
     {"bodies[].shape.cylinder", "Bodies"},
+    {"bodies[].coils[].loop", "Coils"},
+    {"bodies[].coils[].solenoid", "Coils"},
+    {"bodies[].coils[].circular_coil", "Coils"},
+    {"bodies[].coils[].rounded_rectangle", "Coils"},
+    {"bodies[].coils[].segment", "Coils"},
+    {"bodies[].coils[].arc", "Coils"},
     {"timeline[].keys[]", "timeline"},
     {"outcomes[].count_above", "outcomes"},
     {"outcomes[].distance", "outcomes"},

@@ -121,7 +121,8 @@ TEST(SceneParser, ExampleFileMatchesInterface) {
 }
 
 TEST(SceneParser, EveryExampleLoads) {
-  for (const char* name : {"bar_and_ball", "two_magnets", "iron_between_magnets", "drop_on_magnet"})
+  for (const char* name : {"bar_and_ball", "two_magnets", "iron_between_magnets", "drop_on_magnet", "solenoid_plunger",
+                           "superconductor_levitation"})
     EXPECT_NO_THROW(load_scene(std::string(ODEMAG_SOURCE_DIR "/examples/") + name + ".json")) << name;
 }
 
@@ -442,6 +443,97 @@ TEST(SceneParser, MissingFileNamesTheFile) {
 }
 
 // Joints: each type takes its own keys; bodies must exist, differ and not all be fixed.
+// Coils carried by bodies (docs/scene-format.md "Coils"): each type's keys
+// read into its source, defaults where left out; bad types, keys, geometry and
+// ampere-turns rejected with their key; a scale event on a body with coils.
+std::string coil_scene(const std::string& coils, const std::string& extra = "") {
+  return R"({"materials": {"wood": {"type": "inert"}, "iron": {"type": "soft", "saturation": 1.7e6}},
+             "bodies": [{"name": "frame", "shape": {"box": [0.01, 0.01, 0.01]}, "material": "wood", "fixed": true,
+                         "coils": )" +
+         coils + R"(},
+                        {"name": "b", "shape": {"sphere": 0.01}, "material": "iron", "position": [0, 0, 0.05]}])" +
+         (extra.empty() ? "" : ", " + extra) + "}";
+}
+
+TEST(SceneParser, CoilsAreReadPerType) {
+  const SceneDescription s = parse_scene(coil_scene(R"([
+      {"type": "loop", "radius": 0.02, "current": 3, "turns": 10, "axis": [1, 0, 0]},
+      {"type": "solenoid", "radius": 0.01, "length": 0.05, "current": 1, "centre": [0, 0, 0.01]},
+      {"type": "circular_coil", "inner_radius": 0.01, "outer_radius": 0.02, "length": 0.03, "current": 2,
+       "quadrature_order": 12},
+      {"type": "rounded_rectangle", "core_half_width": 0.0125, "core_half_depth": 0.0125,
+       "inner_corner_radius": 0.005, "outer_corner_radius": 0.025, "height": 0.1, "current": 1000},
+      {"type": "segment", "a": [0, 0, 0], "b": [0.1, 0, 0], "current": 5},
+      {"type": "arc", "radius": 0.03, "angle": 1.5, "current": -2}])",
+                                                    R"("timeline": [{"time": 0.1, "action": "scale_magnetization",
+                                                                     "body": "frame", "to": 0.5}])"),
+                                         "coils.json");
+  const std::vector<CoilSource>& c = s.bodies[0].coils;
+  ASSERT_EQ(c.size(), 6u);
+  const CircularLoop& loop = std::get<CircularLoop>(c[0]);
+  EXPECT_EQ(loop.radius, 0.02);
+  EXPECT_EQ(loop.turns, 10.0);
+  EXPECT_EQ(loop.axis.x, 1.0);
+  EXPECT_EQ(std::get<Solenoid>(c[1]).centre.z, 0.01);
+  EXPECT_EQ(std::get<Solenoid>(c[1]).turns, 1.0);  // default
+  EXPECT_EQ(std::get<CircularCoil>(c[2]).quadrature_order, 12);
+  EXPECT_EQ(std::get<RoundedRectangleCoil>(c[3]).quadrature_order, 8);  // default
+  EXPECT_EQ(std::get<RoundedRectangleCoil>(c[3]).width_direction.x, 1.0);
+  EXPECT_EQ(std::get<StraightSegment>(c[4]).b.x, 0.1);
+  EXPECT_EQ(std::get<Arc>(c[5]).angle, 1.5);
+  EXPECT_EQ(std::get<Arc>(c[5]).current, -2.0);
+  EXPECT_TRUE(s.bodies[1].coils.empty());
+  ASSERT_EQ(s.timeline.size(), 1u);
+}
+
+// A linear material (diamagnet): a recoil cell with M_r = 0 and chi < 0;
+// chi outside -1..1e6 rejected with its key.
+TEST(SceneParser, LinearMaterials) {
+  const SceneDescription s = parse_scene(R"({"materials": {"m": {"type": "linear", "susceptibility": -0.5}},
+                                            "bodies": [{"name": "g", "shape": {"sphere": 0.01}, "material": "m"}]})",
+                                         "linear.json");
+  const PermanentMaterial& m = std::get<PermanentMaterial>(s.materials.at("m"));
+  EXPECT_EQ(m.recoil_susceptibility, -0.5);
+  EXPECT_EQ(norm(m.magnetization), 0.0);
+  for (const char* chi : {"-1.5", "2e6", "\"big\""})
+    expect_key(std::string(R"({"materials": {"m": {"type": "linear", "susceptibility": )") + chi +
+                   R"(}}, "bodies": [{"name": "g", "shape": {"sphere": 0.01}, "material": "m"}]})",
+               "materials.m.susceptibility");
+  expect_key(R"({"materials": {"m": {"type": "linear", "susceptibility": -0.5, "magnetization": [0, 0, 1]}},
+                 "bodies": [{"name": "g", "shape": {"sphere": 0.01}, "material": "m"}]})",
+             "materials.m.magnetization");
+}
+
+TEST(SceneParser, RejectsBadCoils) {
+  expect_key(coil_scene(R"({"type": "loop"})"), "bodies[0].coils");
+  expect_key(coil_scene(R"([{"type": "helix", "radius": 0.01, "current": 1}])"), "bodies[0].coils[0].type");
+  expect_key(coil_scene(R"([{"radius": 0.01, "current": 1}])"), "bodies[0].coils[0].type");
+  expect_key(coil_scene(R"([{"type": "loop", "current": 1}])"), "bodies[0].coils[0].radius");
+  expect_key(coil_scene(R"([{"type": "loop", "radius": 0.01}])"), "bodies[0].coils[0].current");
+  expect_key(coil_scene(R"([{"type": "loop", "radius": 0.01, "current": 1, "length": 2}])"),
+             "bodies[0].coils[0].length");  // a key of another type
+  expect_key(coil_scene(R"([{"type": "loop", "radius": -0.01, "current": 1}])"), "bodies[0].coils[0].radius");
+  expect_key(coil_scene(R"([{"type": "loop", "radius": 0.01, "current": 1, "axis": [0, 0, 0]}])"),
+             "bodies[0].coils[0].axis");
+  expect_key(coil_scene(R"([{"type": "loop", "radius": 0.01, "current": 1, "turns": 0}])"),
+             "bodies[0].coils[0].turns");
+  expect_key(coil_scene(R"([{"type": "loop", "radius": 0.01, "current": 1e8, "turns": 100}])"),
+             "bodies[0].coils[0].current");  // 1e10 ampere-turns
+  expect_key(coil_scene(R"([{"type": "circular_coil", "inner_radius": 0.03, "outer_radius": 0.02,
+                              "length": 0.01, "current": 1}])"),
+             "bodies[0].coils[0]");  // inner above outer
+  expect_key(coil_scene(R"([{"type": "circular_coil", "inner_radius": 0.01, "outer_radius": 0.02,
+                              "length": 0.01, "current": 1, "quadrature_order": 65}])"),
+             "bodies[0].coils[0].quadrature_order");
+  expect_key(coil_scene(R"([{"type": "loop", "radius": 0.01, "current": 1e6}])",
+                        R"("timeline": [{"time": 0.1, "action": "scale_magnetization", "body": "frame", "to": 2e3}])"),
+             "timeline[0].to");  // scaled beyond 1e9 A
+  // A scale event on a body with neither magnet nor coils is still refused.
+  expect_key(coil_scene(R"([{"type": "loop", "radius": 0.01, "current": 1}])",
+                        R"("timeline": [{"time": 0.1, "action": "scale_magnetization", "body": "b", "to": 2}])"),
+             "timeline[0].body");
+}
+
 TEST(SceneParser, JointsAreReadAndCheckedPerType) {
   const std::string two = R"([{"name": "a", "shape": {"sphere": 0.01}, "material": "m", "fixed": true},
                               {"name": "b", "shape": {"sphere": 0.01}, "material": "m"}])";

@@ -42,7 +42,7 @@ Vec3 dipole_H(const Vec3& m, const Vec3& r) {
 TEST(SphereNearDipole, AxialForceMatchesKnownSeries) {
   // F = mu0 m^2 / (4 pi D^4) sum gamma_l (l+1)^2 (l+2) (R/D)^(2l+1), attractive.
   const double R = 0.01, m = 1.3;
-  for (double chi : {0.5, 10.0, 1000.0, kInf})
+  for (double chi : {-1.0, -0.5, 0.5, 10.0, 1000.0, kInf})
     for (double D : {1.05 * R, 2.05 * R, 3.0 * R, 10.0 * R}) {
       double sum = 0.0;
       for (int l = 1; l < 20000; ++l) {
@@ -53,6 +53,7 @@ TEST(SphereNearDipole, AxialForceMatchesKnownSeries) {
       const double expected = kMu0 * m * m / (4.0 * kPi * std::pow(D, 4)) * sum;
       const Vec3 F = ref::linear_sphere_force_from_dipole(R, chi, {0, 0, 0}, {0, 0, D}, {0, 0, m});
       EXPECT_NEAR(F.z / expected, 1.0, 1e-12) << chi << " " << D / R;
+      EXPECT_EQ(F.z > 0.0, chi > 0.0) << "attracted (paramagnets) or repelled (diamagnets)";
       EXPECT_NEAR(F.x, 0.0, 1e-14 * std::abs(F.z));
       EXPECT_NEAR(F.y, 0.0, 1e-14 * std::abs(F.z));
       // The reversed dipole gives the same force (quadratic in m).
