@@ -165,6 +165,10 @@ class CudaBackend final : public MagneticBackend {
         throw std::invalid_argument("CUDA backend: body \"" + body.name +
                                     "\" has graded cells, which only the CPU backend supports "
                                     "(MagneticModel::set_graded_cells(false) gives it a uniform lattice)");
+    for (const MagneticBody& body : model.bodies())
+      if (!body.bh_curve.empty())
+        throw std::invalid_argument("CUDA backend: body \"" + body.name +
+                                    "\" has a B-H curve, which only the CPU backend supports");
     double up = upload_tables(model);
 
     // Bodies at this step (all of the model's, indexed by body).

@@ -160,8 +160,11 @@ class CpuBackend final : public MagneticBackend {
       }
       const int off = model.moment_offset(c);
       bool history = state.llg_history[c] != 0;
+      // A B-H curve: the secant gamma_D puts the relaxed cell on the curve.
+      SoftCellParams params = body.soft;
+      if (!body.bh_curve.empty()) params.gamma_D = body.bh_curve.secant_demag_factor(norm(H_A[c]));
       const LocalRelaxResult r = relax_soft_cell(
-          body.soft, R.transpose_times(H_A[c]), &state.moments[off], &state.moment_hc_prev[off],
+          params, R.transpose_times(H_A[c]), &state.moments[off], &state.moment_hc_prev[off],
           history, state.noise_counter[c], noise_stream(state.seed, c), options);
       state.llg_history[c] = history ? 1 : 0;
       state.magnetization[c] = R * (body.soft.Ms * mean_moment(&state.moments[off], body.soft.n));

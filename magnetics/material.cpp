@@ -1,10 +1,13 @@
 #include "magnetics/material.h"
 
+#include "magnetics/bh_curve.h"
+
 #include <cmath>
 
 namespace odemag {
 
 double SoftMaterial::demag_factor() const {
+  if (!bh_curve.empty()) return 1.0 / 3.0 + 1.0 / BhCurve(bh_curve).initial_susceptibility();
   return 1.0 / 3.0 + (std::isinf(susceptibility) ? 0.0 : 1.0 / susceptibility);
 }
 
@@ -28,10 +31,15 @@ std::string validate_one(const PermanentMaterial& m) {
 }
 
 std::string validate_one(const SoftMaterial& m) {
-  if (!std::isfinite(m.saturation) || m.saturation <= 0.0)
-    return "saturation must be finite and > 0";
-  if (std::isnan(m.susceptibility) || m.susceptibility <= 0.0)
-    return "susceptibility must be > 0 (or \"infinite\")";
+  if (!m.bh_curve.empty()) {
+    if (const std::string e = bh_curve_error(m.bh_curve); !e.empty()) return "bh_curve: " + e;
+    if (m.saturation != 0.0 || !std::isinf(m.susceptibility))
+      return "bh_curve sets the saturation and the susceptibility: leave them unset";
+  } else {
+    if (!std::isfinite(m.saturation) || m.saturation <= 0.0) return "saturation must be finite and > 0";
+    if (std::isnan(m.susceptibility) || m.susceptibility <= 0.0)
+      return "susceptibility must be > 0 (or \"infinite\")";
+  }
   if (!std::isfinite(m.anisotropy_field) || m.anisotropy_field < 0.0)
     return "anisotropy_field must be finite and >= 0";
   if (!finite(m.easy_axis) || norm(m.easy_axis) == 0.0)

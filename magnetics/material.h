@@ -1,6 +1,9 @@
 // Magnetic materials (docs/scene-format.md "Materials"). All values in SI units.
 #pragma once
 
+#include <array>
+#include <vector>
+
 #include <limits>
 #include <string>
 #include <variant>
@@ -33,9 +36,15 @@ struct SoftMaterial {
   // The coil's own field outside the core is neglected: the magnetized
   // core's is what acts on other bodies.
   Vec3 coil_field;
+  // An anhysteretic B-H curve (H in A/m, B in T; magnetics/bh_curve.h): empty
+  // for the linear-to-saturation material above. With a curve, Ms is the
+  // curve's last M and chi its initial slope; `saturation` and
+  // `susceptibility` must be left at their defaults.
+  std::vector<std::array<double, 2>> bh_curve;
 
   // Demagnetising factor of a spherical cell including the intrinsic
-  // susceptibility: gamma_D = 1/3 + 1/chi (docs/model.md "Summary of choices", self term).
+  // susceptibility: gamma_D = 1/3 + 1/chi (docs/model.md "Summary of choices", self term);
+  // with a B-H curve at zero field (chi_0), cells take the secant per field.
   double demag_factor() const;
   bool anisotropic() const { return anisotropy_field > 0.0; }
 };

@@ -211,6 +211,10 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
   } else if (const auto* sm = std::get_if<SoftMaterial>(&material)) {
     body.kind = CellKind::soft;
     body.soft.Ms = sm->saturation;
+    if (!sm->bh_curve.empty()) {
+      body.bh_curve = BhCurve(sm->bh_curve);
+      body.soft.Ms = body.bh_curve.saturation();
+    }
     body.soft.gamma_D = sm->demag_factor();
     body.soft.H_K = sm->anisotropy_field;
     body.soft.easy_axis = normalized(sm->easy_axis);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "magnetics/bh_curve.h"
 #include "magnetics/cells.h"
 #include "magnetics/coil.h"
 #include "magnetics/demag_tensor.h"
@@ -35,6 +36,7 @@ struct MagneticBody {
   Vec3 remanence;        // M_r for permanent bodies, body frame
   Vec3 coil_field;       // coil field of an electromagnet's core (soft bodies), body frame
   double recoil = 0.0;   // chi_r for permanent bodies
+  BhCurve bh_curve;      // soft bodies with a B-H curve (empty: linear to saturation)
 
   // Intra-body interaction tensors, computed once per body: H = T(d) mu for
   // every lattice offset d (six components, body frame). T = -N(d) / h^3 with N

@@ -376,7 +376,10 @@ class SphereNearField final : public NearFieldTerm {
       s.radius = body.cells.contact_radius;
       const bool sphere = std::holds_alternative<Sphere>(body.shape);
       if (sphere) {
-        if (body.kind == CellKind::soft) s.chi = std::get<SoftMaterial>(body.material).susceptibility;
+        // A B-H curve: its initial susceptibility (docs/model.md "B-H curves").
+        if (body.kind == CellKind::soft)
+          s.chi = body.bh_curve.empty() ? std::get<SoftMaterial>(body.material).susceptibility
+                                        : body.bh_curve.initial_susceptibility();
         if (body.kind == CellKind::recoil_permanent) s.chi = body.recoil;
       }
       s.volume = body.cells.cell_volume;

@@ -130,7 +130,7 @@ std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene, co
   std::unique_ptr<MagneticBackend> backend;
   try {
     backend = make_backend(o.backend.value_or(scene.solver.backend),
-                           o.threads.value_or(scene.solver.threads), &notice, scene.solver.graded_cells);
+                           o.threads.value_or(scene.solver.threads), &notice, cpu_only_feature(scene));
   } catch (const std::invalid_argument& e) {
     if (o.backend) throw UsageError(std::string("--backend: ") + e.what());
     throw SceneError(scene.file, "solver.backend", e.what());

@@ -23,6 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "magnetics/bh_curve.h"
 #include "magnetics/constants.h"
 
 namespace odemag {
@@ -522,8 +523,8 @@ const KeyTable<MaterialTarget<PermanentMaterial>> kPermanentKeys = {
 
 const KeyTable<MaterialTarget<SoftMaterial>> kSoftKeys = {
     {.name = "type", .read = kReadBefore, .required = true, .doc = {"string", "", "**required**"}},
-    {.name = "saturation", .check = Check::positive, .slot = SLOT(material.saturation), .bound = kFieldStrength, .required = true,
-     .doc = {"number", "A/m", "**required**"}},
+    {.name = "saturation", .check = Check::positive, .slot = SLOT(material.saturation), .bound = kFieldStrength,
+     .doc = {"number", "A/m", "required without `bh_curve`"}},
     {.name = "susceptibility",
      .read = [](const SceneReader& r, const json& x, const std::string& p, MaterialTarget<SoftMaterial>& t) {
        if (x.is_string()) {
@@ -551,6 +552,17 @@ const KeyTable<MaterialTarget<SoftMaterial>> kSoftKeys = {
      .doc = {"integer", "", "`2`"}},
     {.name = "coil_field", .check = Check::vec3, .slot = SLOT(material.coil_field), .bound = kFieldStrength,
      .doc = {"[x, y, z]", "A/m, body frame", "`[0, 0, 0]`"}},
+    {.name = "bh_curve",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, MaterialTarget<SoftMaterial>& t) {
+       if (!x.is_array() || x.size() < 2) r.fail(p, "must be an array of at least two [H, B] points (A/m, T)");
+       for (size_t i = 0; i < x.size(); ++i) {
+         r.require_array(x[i], element(p, i), 2);
+         t.material.bh_curve.push_back({r.non_negative(x[i][0], element(element(p, i), 0)),
+                                        r.non_negative(x[i][1], element(element(p, i), 1))});
+       }
+       if (const std::string e = bh_curve_error(t.material.bh_curve); !e.empty()) r.fail(p, e);
+     },
+     .doc = {"[[H, B], ...]", "A/m, T", "none"}},
     {.name = "color", .check = Check::color, .slot = SLOT(color),
      .doc = {"[r, g, b]", "", "material default"}},
 };
@@ -586,6 +598,13 @@ Material read_material(const SceneReader& r, const json& v, const std::string& p
   r.require_object(v, path);
   const std::string type =
       r.choice(r.required(v, "type", path), member(path, "type"), {"permanent", "soft", "linear", "inert"});
+  if (type == "soft") {
+    // saturation and susceptibility come from a B-H curve where there is one.
+    const bool curve = v.contains("bh_curve");
+    if (!curve && !v.contains("saturation")) r.fail(member(path, "saturation"), "required key is missing (or give a bh_curve)");
+    for (const char* key : {"saturation", "susceptibility"})
+      if (curve && v.contains(key)) r.fail(member(path, key), "the bh_curve sets it: leave it out");
+  }
   const Material material = type == "permanent" ? read_material_keys(r, v, path, kPermanentKeys, color)
                             : type == "linear"  ? read_material_keys(r, v, path, kLinearKeys, color)
                             : type == "soft"    ? read_material_keys(r, v, path, kSoftKeys, color)

@@ -78,12 +78,20 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene) {
   return counts;
 }
 
+std::string cpu_only_feature(const SceneDescription& scene) {
+  if (scene.solver.graded_cells) return "graded cells (solver.graded_cells)";
+  for (const auto& [name, material] : scene.materials)
+    if (const auto* soft = std::get_if<SoftMaterial>(&material); soft && !soft->bh_curve.empty())
+      return "a B-H curve (materials." + name + ".bh_curve)";
+  return "";
+}
+
 std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threads,
-                                              std::string* notice, bool graded_cells) {
+                                              std::string* notice, const std::string& cpu_only) {
   if (name == "cpu") return make_cpu_backend(threads);
-  if (graded_cells && name == "cuda")
-    throw std::invalid_argument("backend \"cuda\" does not support graded cells (solver.graded_cells)");
-  if (graded_cells && name == "auto") return make_cpu_backend(threads);
+  if (!cpu_only.empty() && name == "cuda")
+    throw std::invalid_argument("backend \"cuda\" does not support " + cpu_only);
+  if (!cpu_only.empty() && name == "auto") return make_cpu_backend(threads);
   if (name == "cuda" || name == "auto") {
     std::string why;
     if (auto gpu = make_cuda_backend(&why)) return gpu;

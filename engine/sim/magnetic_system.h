@@ -48,9 +48,13 @@ BodyPose scene_pose(const BodyDescription& body);
 // Backend by name: "cpu", "cuda" or "auto". "auto" falls back to the CPU
 // backend when no CUDA device is usable and writes one notice to `notice`;
 // "cuda" without a device throws std::invalid_argument (usage error, exit 2).
-// graded_cells (SolverSettings::graded_cells): the CPU backend only, so
-// "auto" picks it and "cuda" throws.
+// cpu_only: a feature of the scene that only the CPU backend supports
+// (cpu_only_feature), so "auto" picks it and "cuda" throws naming it.
 std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threads,
-                                              std::string* notice, bool graded_cells = false);
+                                              std::string* notice, const std::string& cpu_only = "");
+
+// "" or the first of the scene's CPU-only features, as a user reads it: graded
+// cells (solver.graded_cells), a B-H curve (materials.NAME.bh_curve).
+std::string cpu_only_feature(const SceneDescription& scene);
 
 }  // namespace odemag

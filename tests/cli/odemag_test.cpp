@@ -153,6 +153,24 @@ TEST_F(Cli, GradedCellsKeyRefinesASoftCube) {
   EXPECT_NE(cuda.err.find("graded cells"), std::string::npos) << cuda.err;
 }
 
+// A B-H curve material: `solve` runs it on the CPU backend with "auto" (the
+// default) and refuses "cuda" with exit 2 naming the material's key; the
+// ball's moment is along the field and below the saturated moment.
+TEST_F(Cli, BhCurveRunsOnTheCpuBackendOnly) {
+  const fs::path scene = write("bh.json", R"({"external_field": [0, 0, 2e4],
+      "materials": {"steel": {"type": "soft", "bh_curve": [[0, 0], [200, 0.6], [1000, 1.3], [1e4, 1.7], [1e5, 2.0]]}},
+      "bodies": [{"name": "ball", "shape": {"sphere": 0.005}, "material": "steel", "fixed": true}]})");
+  const ProgramRun cpu = odemag("solve " + shell_quote(scene.string()));
+  ASSERT_EQ(cpu.status, 0) << cpu.err;
+  const Vec3 m = vec(json::parse(cpu.out)["bodies"][0]["moment"]);
+  const double V = 4.0 / 3.0 * M_PI * std::pow(0.005, 3), Ms = 2.0 / (4e-7 * M_PI) - 1e5;
+  EXPECT_GT(m.z, 0.0);
+  EXPECT_LT(m.z, Ms * V);
+  const ProgramRun cuda = odemag("solve " + shell_quote(scene.string()) + " --backend cuda");
+  EXPECT_EQ(cuda.status, 2);
+  EXPECT_NE(cuda.err.find("materials.steel.bh_curve"), std::string::npos) << cuda.err;
+}
+
 TEST_F(Cli, SolveEveryExample) {
   for (const auto& entry : fs::directory_iterator(kExamples)) {
     if (entry.path().extension() != ".json") continue;

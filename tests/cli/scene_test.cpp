@@ -504,6 +504,31 @@ TEST(SceneParser, LinearMaterials) {
              "materials.m.magnetization");
 }
 
+// A soft material with a B-H curve: the points read as given; saturation and
+// susceptibility then rejected, saturation required without a curve, bad
+// curves rejected with the key.
+TEST(SceneParser, BhCurves) {
+  auto scene = [](const std::string& material) {
+    return R"({"materials": {"s": )" + material +
+           R"(}, "bodies": [{"name": "g", "shape": {"sphere": 0.01}, "material": "s"}]})";
+  };
+  const SceneDescription s =
+      parse_scene(scene(R"({"type": "soft", "bh_curve": [[0, 0], [100, 0.5], [1000, 1.5], [1e5, 2.1]]})"), "bh.json");
+  const SoftMaterial& m = std::get<SoftMaterial>(s.materials.at("s"));
+  ASSERT_EQ(m.bh_curve.size(), 4u);
+  EXPECT_EQ(m.bh_curve[2][0], 1000.0);
+  EXPECT_EQ(m.bh_curve[3][1], 2.1);
+  expect_key(scene(R"({"type": "soft", "bh_curve": [[0, 0], [100, 0.5]], "saturation": 1e6})"),
+             "materials.s.saturation");
+  expect_key(scene(R"({"type": "soft", "bh_curve": [[0, 0], [100, 0.5]], "susceptibility": 10})"),
+             "materials.s.susceptibility");
+  expect_key(scene(R"({"type": "soft"})"), "materials.s.saturation");
+  expect_key(scene(R"({"type": "soft", "bh_curve": [[0, 0]]})"), "materials.s.bh_curve");
+  expect_key(scene(R"({"type": "soft", "bh_curve": [[0, 0], [100, 0.5], [50, 0.7]]})"), "materials.s.bh_curve");
+  expect_key(scene(R"({"type": "soft", "bh_curve": [[0, 0], [100, -0.5]]})"), "materials.s.bh_curve[1][1]");
+  expect_key(scene(R"({"type": "soft", "bh_curve": [[0, 0], [100]]})"), "materials.s.bh_curve[1]");
+}
+
 TEST(SceneParser, RejectsBadCoils) {
   expect_key(coil_scene(R"({"type": "loop"})"), "bodies[0].coils");
   expect_key(coil_scene(R"([{"type": "helix", "radius": 0.01, "current": 1}])"), "bodies[0].coils[0].type");
