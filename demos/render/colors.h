@@ -33,6 +33,7 @@ inline constexpr RenderColor dark_steel{0.35f, 0.36f, 0.39f};
 inline constexpr RenderColor crane{0.95f, 0.68f, 0.12f};      // crane yellow
 inline constexpr RenderColor wood{0.72f, 0.55f, 0.36f};
 inline constexpr RenderColor field_line{0.45f, 0.45f, 0.47f}; // magnetic field lines
+inline constexpr RenderColor copper{0.80f, 0.45f, 0.20f};     // coils carried by bodies
 inline constexpr RenderColor north{0.85f, 0.15f, 0.12f};      // magnet N pole
 inline constexpr RenderColor south{0.15f, 0.30f, 0.85f};      // magnet S pole
 }  // namespace palette

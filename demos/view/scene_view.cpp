@@ -102,6 +102,83 @@ ViewOptions view_options(const SceneDescription& scene) {
   return o;
 }
 
+namespace {
+
+// The conductors of a coil (magnetics/coil.h) as polylines in its frame, for
+// drawing: a loop's circle, a solenoid's end rings and eight turns between,
+// a finite-section winding's inner and outer rings at both ends, a
+// rounded-rectangle winding's inner and outer outlines at both ends, a
+// segment, an arc. Orientation: the source's axis (and width direction).
+std::vector<std::vector<Vec3>> coil_outlines(const CoilSource& source) {
+  constexpr int kSides = 48;
+  auto frame = [](const Vec3& axis, Vec3 width, Vec3& u, Vec3& v, Vec3& w) {
+    w = normalized(axis);
+    width = width - dot(width, w) * w;
+    if (norm(width) < 1e-12) width = std::fabs(w.x) < 0.9 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
+    width = width - dot(width, w) * w;
+    u = normalized(width);
+    v = cross(w, u);
+  };
+  auto ring = [&](const Vec3& centre, const Vec3& axis, double radius, double height, double angle0, double angle) {
+    Vec3 u, v, w;
+    frame(axis, {1.0, 0.0, 0.0}, u, v, w);
+    std::vector<Vec3> pts;
+    const int n = std::max(2, static_cast<int>(std::ceil(kSides * std::fabs(angle) / (2.0 * kPi))));
+    for (int i = 0; i <= n; ++i) {
+      const double t = angle0 + angle * i / n;
+      pts.push_back(centre + height * w + radius * (std::cos(t) * u + std::sin(t) * v));
+    }
+    return pts;
+  };
+  std::vector<std::vector<Vec3>> out;
+  std::visit(
+      Overloaded{
+          [&](const CircularLoop& l) { out.push_back(ring(l.centre, l.axis, l.radius, 0.0, 0.0, 2.0 * kPi)); },
+          [&](const StraightSegment& s) { out.push_back({s.a, s.b}); },
+          [&](const Arc& a) {
+            Vec3 u, v, w;
+            frame(a.axis, a.start, u, v, w);
+            std::vector<Vec3> pts;
+            const int n = std::max(2, static_cast<int>(std::ceil(kSides * std::fabs(a.angle) / (2.0 * kPi))));
+            for (int i = 0; i <= n; ++i) {
+              const double t = a.angle * i / n;
+              pts.push_back(a.centre + a.radius * (std::cos(t) * u + std::sin(t) * v));
+            }
+            out.push_back(pts);
+          },
+          [&](const Solenoid& s) {
+            for (int i = 0; i <= 8; ++i)
+              out.push_back(ring(s.centre, s.axis, s.radius, s.length * (i / 8.0 - 0.5), 0.0, 2.0 * kPi));
+          },
+          [&](const CircularCoil& c) {
+            for (double z : {-0.5 * c.length, 0.5 * c.length})
+              for (double r : {c.inner_radius, c.outer_radius})
+                if (r > 0.0) out.push_back(ring(c.centre, c.axis, r, z, 0.0, 2.0 * kPi));
+          },
+          [&](const RoundedRectangleCoil& c) {
+            Vec3 u, v, w;
+            frame(c.axis, c.width_direction, u, v, w);
+            for (double z : {-0.5 * c.height, 0.5 * c.height})
+              for (double r : {c.inner_corner_radius, c.outer_corner_radius}) {
+                // The core rectangle's outline pushed out by r: four quarter arcs about its corners.
+                std::vector<Vec3> pts;
+                const double cu[4] = {1, -1, -1, 1}, cv[4] = {1, 1, -1, -1};
+                for (int k = 0; k < 4; ++k) {
+                  const Vec3 corner = c.centre + z * w + (cu[k] * c.core_half_width) * u + (cv[k] * c.core_half_depth) * v;
+                  for (int i = 0; i <= 12; ++i) {
+                    const double t = 0.5 * kPi * (k + i / 12.0);
+                    pts.push_back(corner + r * (std::cos(t) * u + std::sin(t) * v));
+                  }
+                }
+                pts.push_back(pts.front());
+                out.push_back(pts);
+              }
+          }},
+      source);
+  return out;
+}
+}  // namespace
+
 std::vector<RenderLine> trace_field_lines(const MagneticModel& model, const MagneticState& state,
                                           MagneticBackend& backend, int count, double size) {
   // Seeds: rings on the north faces of the magnetized bodies: every magnet
@@ -231,6 +308,18 @@ RenderFrame render_scene_of(const Simulation& sim, const ViewOptions& options, M
   if (options.field_lines && field_backend)
     view.lines = trace_field_lines(model, magnetics.state(), *field_backend, options.field_line_count,
                                    scene_size(scene));
+  // Coils carried by bodies: their conductors in copper, at the body's pose.
+  for (const AttachedCoil& k : model.coils()) {
+    if (!sim.world().enabled(k.body)) continue;
+    const BodyPose pose = sim.world().pose(k.body);
+    for (const std::vector<Vec3>& outline : coil_outlines(k.source)) {
+      RenderLine line;
+      for (const Vec3& x : outline) line.points.push_back(pose.position + pose.rotation * x);
+      line.color = palette::copper;
+      line.width = 2.5f;
+      view.lines.push_back(line);
+    }
+  }
   if (options.caption) {
     char t[64];
     std::snprintf(t, sizeof t, "t = %.2f s", sim.time());

@@ -61,6 +61,37 @@ TEST(SceneView, MagnetsSplitAlongTheirMagnetizationOthersInTheirColours) {
   EXPECT_FALSE(render_scene_of(sim, bare, nullptr).legend.any());
 }
 
+// A coil carried by the (turned, shifted) wood block is drawn as copper
+// polylines at the block's pose: a circular coil's four rings, every point at
+// its inner or outer radius from the turned axis, on its end planes.
+TEST(SceneView, CoilsAreDrawnAtTheirBodysPose) {
+  SceneDescription scene = small_scene();
+  CircularCoil coil;
+  coil.inner_radius = 0.01;
+  coil.outer_radius = 0.015;
+  coil.length = 0.02;
+  coil.current = 100.0;
+  coil.centre = {0.0, 0.0, 0.005};  // body frame
+  scene.bodies[2].coils.push_back(coil);
+  scene.bodies[2].orientation = {std::cos(0.25 * M_PI), std::sin(0.25 * M_PI), 0.0, 0.0};  // 90 degrees about x
+  Simulation sim(scene, make_cpu_backend(1));
+  const RenderFrame view = render_scene_of(sim, ViewOptions{}, nullptr);
+  const BodyPose pose = sim.world().pose(2);
+  const Vec3 axis = pose.rotation * Vec3{0.0, 0.0, 1.0}, centre = pose.position + pose.rotation * coil.centre;
+  int copper = 0;
+  for (const RenderLine& line : view.lines) {
+    if (line.color != palette::copper) continue;
+    ++copper;
+    for (const Vec3& x : line.points) {
+      const Vec3 d = x - centre;
+      const double along = dot(d, axis), radial = norm(d - along * axis);
+      EXPECT_NEAR(std::fabs(along), 0.01, 1e-9);
+      EXPECT_TRUE(std::fabs(radial - 0.01) < 1e-9 || std::fabs(radial - 0.015) < 1e-9) << radial;
+    }
+  }
+  EXPECT_EQ(copper, 4);
+}
+
 TEST(SceneView, ForceColoursRankBodiesByForce) {
   SceneDescription scene = small_scene();
   scene.render.force_colors = true;
