@@ -272,7 +272,7 @@ class SharedCorners {
         for (int c = 0; c < 2; ++c) {
           Corner& x = corners_[(static_cast<std::size_t>(lo[0] + a) * count_[1] + lo[1] + b) * count_[2] + lo[2] + c];
           if (x.generation != generation_) {
-            cuboid_corner(t.offset[0][a], t.offset[1][b], t.offset[2][c], eps_, x.angle, x.inverse_distance);
+            cuboid_corner(t.offset[0][a], t.offset[1][b], t.offset[2][c], eps_, true, x.angle, x.inverse_distance);
             x.generation = generation_;
           }
           for (int m = 0; m < 3; ++m) t.angle[a][b][c][m] = x.angle[m];
@@ -285,7 +285,7 @@ class SharedCorners {
           Edge& x = edges_[e][(static_cast<std::size_t>(lo[u] + a) * count_[w] + lo[w] + b) * (count_[along] - 1) +
                               lo[along]];
           if (x.generation != generation_) {
-            cuboid_edge(t.offset[u][a], t.offset[w][b], t.offset[along][0], t.offset[along][1], eps_, x.log_term,
+            cuboid_edge(t.offset[u][a], t.offset[w][b], t.offset[along][0], t.offset[along][1], eps_, true, x.log_term,
                         x.ratio);
             x.generation = generation_;
           }

@@ -29,7 +29,7 @@ std::string bh_curve_error(const std::vector<std::array<double, 2>>& points) {
   return {};
 }
 
-BhCurve::BhCurve(const std::vector<std::array<double, 2>>& points) : points_(points) {
+BhCurve::BhCurve(const std::vector<std::array<double, 2>>& points) {
   if (const std::string e = bh_curve_error(points); !e.empty()) throw std::invalid_argument("B-H curve: " + e);
   if (points.front()[0] > 0.0) {
     H_.push_back(0.0);

@@ -36,7 +36,6 @@ class BhCurve {
   double slope(double H) const;                // dM/dH
   double saturation() const { return M_.empty() ? 0.0 : M_.back(); }  // Ms, A/m
   double initial_susceptibility() const { return slope(0.0); }
-  const std::vector<std::array<double, 2>>& points() const { return points_; }
 
   // The cell's M (A/m, >= 0) in applied field magnitude h: M = M(h - M / 3).
   double cell_magnetization(double h) const;
@@ -44,7 +43,6 @@ class BhCurve {
   double secant_demag_factor(double h) const;
 
  private:
-  std::vector<std::array<double, 2>> points_;  // as given
   std::vector<double> H_, M_, d_;              // knots from H = 0, values, Hermite slopes
 };
 

@@ -76,23 +76,27 @@ struct CuboidCornerTerms {
 // of a face plane count as on it (cuboid_demag_tensor).
 ODEMAG_HD double cuboid_snap_distance(const Vec3& half) { return 1e-12 * (half.x + half.y + half.z); }
 
-// The three angles and 1 / R at corner offsets (X, Y, Z), unsnapped, of a
-// cuboid with snapping distance eps.
-ODEMAG_HD void cuboid_corner(double X, double Y, double Z, double eps, double angle[3], double& inverse_distance) {
-  auto snap = [eps](double v) { return fabs(v) < eps ? 0.0 : v; };
-  const double Xs = snap(X), Ys = snap(Y), Zs = snap(Z);
+// An offset from a face plane, 0 within the snapping distance eps.
+ODEMAG_HD double snap_to_plane(double v, double eps) { return fabs(v) < eps ? 0.0 : v; }
+
+// The three angles at corner offsets (X, Y, Z), unsnapped, of a cuboid with
+// snapping distance eps; with_gradient: also 1 / R.
+ODEMAG_HD void cuboid_corner(double X, double Y, double Z, double eps, bool with_gradient, double angle[3],
+                             double& inverse_distance) {
+  const double Xs = snap_to_plane(X, eps), Ys = snap_to_plane(Y, eps), Zs = snap_to_plane(Z, eps);
   angle[0] = corner_angle(Xs, Ys, Zs);
   angle[1] = corner_angle(Ys, Xs, Zs);
   angle[2] = corner_angle(Zs, Xs, Ys);
-  inverse_distance = 1.0 / sqrt(fmax(X * X + Y * Y + Z * Z, eps * eps));
+  if (with_gradient) inverse_distance = 1.0 / sqrt(fmax(X * X + Y * Y + Z * Z, eps * eps));
 }
 
-// log_pair and edge_ratio of the edge at offsets (U, W) from its two planes,
-// running from offset A (the lower plane) to B (the upper), unsnapped.
-ODEMAG_HD void cuboid_edge(double U, double W, double A, double B, double eps, double& log_term, double& ratio) {
-  auto snap = [eps](double v) { return fabs(v) < eps ? 0.0 : v; };
-  log_term = log_pair(snap(U), snap(W), snap(A), snap(B), eps);
-  ratio = edge_ratio(U, W, A, B, eps);
+// log_pair of the edge at offsets (U, W) from its two planes, running from
+// offset A (the lower plane) to B (the upper), unsnapped; with_gradient: also
+// edge_ratio.
+ODEMAG_HD void cuboid_edge(double U, double W, double A, double B, double eps, bool with_gradient,
+                           double& log_term, double& ratio) {
+  log_term = log_pair(snap_to_plane(U, eps), snap_to_plane(W, eps), snap_to_plane(A, eps), snap_to_plane(B, eps), eps);
+  if (with_gradient) ratio = edge_ratio(U, W, A, B, eps);
 }
 
 // The corner terms of the cuboid of half extents `half` centred at the
@@ -105,33 +109,18 @@ ODEMAG_HD void cuboid_corner_terms(const Vec3& p, const Vec3& half, bool with_gr
     t.offset[k][0] = P[k] + H[k];
     t.offset[k][1] = P[k] - H[k];
   }
-  auto snap = [eps](double v) { return fabs(v) < eps ? 0.0 : v; };
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j)
-      for (int l = 0; l < 2; ++l) {
-        const double X = t.offset[0][i], Y = t.offset[1][j], Z = t.offset[2][l];
-        if (with_gradient) {
-          cuboid_corner(X, Y, Z, eps, t.angle[i][j][l], t.inverse_distance[i][j][l]);
-        } else {
-          const double Xs = snap(X), Ys = snap(Y), Zs = snap(Z);
-          t.angle[i][j][l][0] = corner_angle(Xs, Ys, Zs);
-          t.angle[i][j][l][1] = corner_angle(Ys, Xs, Zs);
-          t.angle[i][j][l][2] = corner_angle(Zs, Xs, Ys);
-        }
-      }
+      for (int l = 0; l < 2; ++l)
+        cuboid_corner(t.offset[0][i], t.offset[1][j], t.offset[2][l], eps, with_gradient, t.angle[i][j][l],
+                      t.inverse_distance[i][j][l]);
   // Edge e runs along axis `along[e]` between planes of axes u[e], w[e].
   constexpr int u[3] = {0, 0, 1}, w[3] = {1, 2, 2}, along[3] = {2, 1, 0};
   for (int e = 0; e < 3; ++e)
     for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2; ++j) {
-        const double U = t.offset[u[e]][i], W = t.offset[w[e]][j];
-        const double A = t.offset[along[e]][0], B = t.offset[along[e]][1];
-        if (with_gradient) {
-          cuboid_edge(U, W, A, B, eps, t.log_pair[e][i][j], t.edge_ratio[e][i][j]);
-        } else {
-          t.log_pair[e][i][j] = log_pair(snap(U), snap(W), snap(A), snap(B), eps);
-        }
-      }
+      for (int j = 0; j < 2; ++j)
+        cuboid_edge(t.offset[u[e]][i], t.offset[w[e]][j], t.offset[along[e]][0], t.offset[along[e]][1], eps,
+                    with_gradient, t.log_pair[e][i][j], t.edge_ratio[e][i][j]);
 }
 
 // Demagnetising tensor N(p) of an axis-aligned cuboid of half extents

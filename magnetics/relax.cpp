@@ -71,17 +71,24 @@ void record_solve(MagneticState& state, const RelaxOptions& o, bool converged) {
 // drops a NaN second argument). Equal to std::max(a, b) otherwise.
 double max_keeping_nan(double a, double b) { return b > a || std::isnan(b) ? b : a; }
 
-// H (A/m) at world point x of the model's coils (AttachedCoil) that are
-// carried by an active body other than `skip_body`, each at its body's pose,
-// its current times the body's magnetization_scale.
+// Whether coil k acts: its body active and its current not scaled to 0.
+bool coil_acts(const MagneticState& state, const AttachedCoil& k) {
+  return state.active[k.body] && state.magnetization_scale[k.body] != 0.0;
+}
+
+// H (A/m) of coil k at world point x, at its body's pose, its current times
+// the body's magnetization_scale.
+Vec3 coil_H(const MagneticState& state, const AttachedCoil& k, const Vec3& x) {
+  const BodyPose& pose = state.pose[k.body];
+  return state.magnetization_scale[k.body] * coil_field_H(k.source, pose.rotation, pose.position, x);
+}
+
+// H (A/m) at world point x of the model's acting coils (AttachedCoil) carried
+// by bodies other than `skip_body`.
 Vec3 attached_coil_field(const MagneticModel& model, const MagneticState& state, const Vec3& x, int skip_body) {
   Vec3 H;
-  for (const AttachedCoil& k : model.coils()) {
-    const double scale = state.magnetization_scale[k.body];
-    if (k.body == skip_body || !state.active[k.body] || scale == 0.0) continue;
-    const BodyPose& pose = state.pose[k.body];
-    H += scale * coil_field_H(k.source, pose.rotation, pose.position, x);
-  }
+  for (const AttachedCoil& k : model.coils())
+    if (k.body != skip_body && coil_acts(state, k)) H += coil_H(state, k, x);
   return H;
 }
 
@@ -115,21 +122,18 @@ void add_coil_forces(const MagneticModel& model, MagneticState& state) {
     const Vec3& x = state.cell_position[c];
     const double step = 1e-4 * std::max(model.cell_contact_radius(c), 1e-9);
     for (const AttachedCoil& k : model.coils()) {
-      const double scale = state.magnetization_scale[k.body];
-      if (k.body == b || !state.active[k.body] || scale == 0.0) continue;
-      const BodyPose& pose = state.pose[k.body];
-      auto H_at = [&](const Vec3& p) { return scale * coil_field_H(k.source, pose.rotation, pose.position, p); };
+      if (k.body == b || !coil_acts(state, k)) continue;
       Vec3 F;
       for (int j = 0; j < 3; ++j) {
         Vec3 e;
         e[j] = step;
-        F[j] = kMu0 * dot(mu, H_at(x + e) - H_at(x - e)) / (2.0 * step);
+        F[j] = kMu0 * dot(mu, coil_H(state, k, x + e) - coil_H(state, k, x - e)) / (2.0 * step);
       }
-      const Vec3 tau_mu = kMu0 * cross(mu, H_at(x));
+      const Vec3 tau_mu = kMu0 * cross(mu, coil_H(state, k, x));
       state.force[b] += F;
       state.torque[b] += cross(x - state.pose[b].position, F) + tau_mu;
       state.force[k.body] -= F;
-      state.torque[k.body] -= cross(x - pose.position, F) + tau_mu;
+      state.torque[k.body] -= cross(x - state.pose[k.body].position, F) + tau_mu;
     }
   }
 }
