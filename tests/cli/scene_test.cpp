@@ -122,7 +122,7 @@ TEST(SceneParser, ExampleFileMatchesInterface) {
 
 TEST(SceneParser, EveryExampleLoads) {
   for (const char* name : {"bar_and_ball", "two_magnets", "iron_between_magnets", "drop_on_magnet", "solenoid_plunger",
-                           "superconductor_levitation"})
+                           "superconductor_levitation", "relay_armature"})
     EXPECT_NO_THROW(load_scene(std::string(ODEMAG_SOURCE_DIR "/examples/") + name + ".json")) << name;
 }
 
