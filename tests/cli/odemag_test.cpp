@@ -69,6 +69,17 @@ class Cli : public ::testing::Test {
     EXPECT_EQ(err[0].rfind("odemag: " + scene.string() + ": " + key + ": ", 0), 0u) << r.err;
   }
 
+  // Runs examples/<name>.json headless on one CPU thread: its summary's
+  // outcomes, or null (the failure recorded) when the run fails.
+  json example_outcomes(const std::string& name) {
+    const fs::path out = dir_ / name;
+    const ProgramRun r = odemag("run " + shell_quote(kExamples + name + ".json") + " --out " +
+                                shell_quote(out.string()) + " --frames no --quiet yes --backend cpu --threads 1");
+    EXPECT_EQ(r.status, 0) << r.err;
+    if (r.status != 0) return nullptr;
+    return json::parse(read_file(out / "summary.json"))["outcomes"];
+  }
+
   fs::path dir_;
 };
 
@@ -322,11 +333,8 @@ TEST_F(Cli, MissingSceneFileExitsTwo) {
 // switched off no force is left (soft steel without anisotropy keeps no
 // remanence).
 TEST_F(Cli, SolenoidPullsThePlungerToItsCentre) {
-  const fs::path out = dir_ / "plunger";
-  const ProgramRun r = odemag("run " + shell_quote(kExamples + "solenoid_plunger.json") + " --out " +
-                              shell_quote(out.string()) + " --frames no --quiet yes --backend cpu --threads 1");
-  ASSERT_EQ(r.status, 0) << r.err;
-  const json outcomes = json::parse(read_file(out / "summary.json"))["outcomes"];
+  const json outcomes = example_outcomes("solenoid_plunger");
+  ASSERT_FALSE(outcomes.is_null());
   EXPECT_GT(outcomes["pull_at_start"].get<double>(), 0.01);
   const double d = outcomes["plunger_to_coil_at_switch_off"].get<double>();
   EXPECT_NEAR(d, std::hypot(0.04, 0.008), 1e-5)
@@ -343,11 +351,8 @@ TEST_F(Cli, SolenoidPullsThePlungerToItsCentre) {
 // resting on the core's edge 0.417), two contact points while on, pull
 // 0.23 N down.
 TEST_F(Cli, RelayArmatureClosesWhileTheCoilIsOnAndOpensAfter) {
-  const fs::path out = dir_ / "relay";
-  const ProgramRun r = odemag("run " + shell_quote(kExamples + "relay_armature.json") + " --out " +
-                              shell_quote(out.string()) + " --frames no --quiet yes --backend cpu --threads 1");
-  ASSERT_EQ(r.status, 0) << r.err;
-  const json outcomes = json::parse(read_file(out / "summary.json"))["outcomes"];
+  const json outcomes = example_outcomes("relay_armature");
+  ASSERT_FALSE(outcomes.is_null());
   EXPECT_EQ(outcomes["contacts_before_switch_on"].get<double>(), 0.0);
   EXPECT_GT(outcomes["contacts_while_on"].get<double>(), 0.0) << "the armature is not pulled onto the core";
   EXPECT_EQ(outcomes["contacts_after_switch_off"].get<double>(), 0.0) << "the armature sticks after switch-off";
@@ -370,11 +375,8 @@ TEST_F(Cli, RelayArmatureClosesWhileTheCoilIsOnAndOpensAfter) {
 // above the magnet (top at 20 mm; measured centre 47 mm) and the magnetic
 // lift carries its weight (measured 1.0% above it, still settling).
 TEST_F(Cli, SuperconductingBallHoversOverTheMagnet) {
-  const fs::path out = dir_ / "levitation";
-  const ProgramRun r = odemag("run " + shell_quote(kExamples + "superconductor_levitation.json") + " --out " +
-                              shell_quote(out.string()) + " --frames no --quiet yes --backend cpu --threads 1");
-  ASSERT_EQ(r.status, 0) << r.err;
-  const json outcomes = json::parse(read_file(out / "summary.json"))["outcomes"];
+  const json outcomes = example_outcomes("superconductor_levitation");
+  ASSERT_FALSE(outcomes.is_null());
   const double weight = 6300.0 * 4.0 / 3.0 * M_PI * std::pow(0.005, 3) * 9.81;
   EXPECT_GT(outcomes["lowest"].get<double>(), 0.03) << "the ball never comes near the magnet";
   EXPECT_GT(outcomes["hover_height"].get<double>(), 0.035);
