@@ -72,11 +72,18 @@ void hermite(double t, double& h00, double& h10, double& h01, double& h11) {
 }
 }  // namespace
 
+size_t BhCurve::segment(double H, double& w, double& t) const {
+  const size_t i = static_cast<size_t>(std::upper_bound(H_.begin(), H_.end(), H) - H_.begin()) - 1;
+  w = H_[i + 1] - H_[i];
+  t = (H - H_[i]) / w;
+  return i;
+}
+
 double BhCurve::magnetization(double H) const {
   if (H_.empty() || H <= 0.0) return 0.0;
   if (H >= H_.back()) return M_.back();
-  const size_t i = static_cast<size_t>(std::upper_bound(H_.begin(), H_.end(), H) - H_.begin()) - 1;
-  const double w = H_[i + 1] - H_[i], t = (H - H_[i]) / w;
+  double w, t;
+  const size_t i = segment(H, w, t);
   double h00, h10, h01, h11;
   hermite(t, h00, h10, h01, h11);
   return h00 * M_[i] + h10 * w * d_[i] + h01 * M_[i + 1] + h11 * w * d_[i + 1];
@@ -86,8 +93,9 @@ double BhCurve::slope(double H) const {
   if (H_.empty()) return 0.0;
   if (H <= 0.0) return d_[0];
   if (H >= H_.back()) return 0.0;
-  const size_t i = static_cast<size_t>(std::upper_bound(H_.begin(), H_.end(), H) - H_.begin()) - 1;
-  const double w = H_[i + 1] - H_[i], t = (H - H_[i]) / w, t2 = t * t;
+  double w, t;
+  const size_t i = segment(H, w, t);
+  const double t2 = t * t;
   const double g00 = 6 * t2 - 6 * t, g10 = 3 * t2 - 4 * t + 1, g01 = -6 * t2 + 6 * t, g11 = 3 * t2 - 2 * t;
   // >= 0 for a monotone interpolant; the max removes round-off.
   return std::max(0.0, (g00 * M_[i] + g01 * M_[i + 1]) / w + g10 * d_[i] + g11 * d_[i + 1]);

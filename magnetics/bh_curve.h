@@ -43,6 +43,10 @@ class BhCurve {
   double secant_demag_factor(double h) const;
 
  private:
+  // The knot interval [H_i, H_i+1] holding 0 < H < H_back: i, its width w and
+  // the position t in it (0..1).
+  size_t segment(double H, double& w, double& t) const;
+
   std::vector<double> H_, M_, d_;              // knots from H = 0, values, Hermite slopes
 };
 
