@@ -119,41 +119,34 @@ std::vector<std::vector<Vec3>> coil_outlines(const CoilSource& source) {
     u = normalized(width);
     v = cross(w, u);
   };
-  auto ring = [&](const Vec3& centre, const Vec3& axis, double radius, double height, double angle0, double angle) {
+  // An arc of `angle` about `axis` from the direction `start`, `height` along the axis off `centre`.
+  auto ring = [&](const Vec3& centre, const Vec3& axis, const Vec3& start, double radius, double height,
+                  double angle) {
     Vec3 u, v, w;
-    frame(axis, {1.0, 0.0, 0.0}, u, v, w);
+    frame(axis, start, u, v, w);
     std::vector<Vec3> pts;
     const int n = std::max(2, static_cast<int>(std::ceil(kSides * std::fabs(angle) / (2.0 * kPi))));
     for (int i = 0; i <= n; ++i) {
-      const double t = angle0 + angle * i / n;
+      const double t = angle * i / n;
       pts.push_back(centre + height * w + radius * (std::cos(t) * u + std::sin(t) * v));
     }
     return pts;
   };
+  const Vec3 x_axis{1.0, 0.0, 0.0};
   std::vector<std::vector<Vec3>> out;
   std::visit(
       Overloaded{
-          [&](const CircularLoop& l) { out.push_back(ring(l.centre, l.axis, l.radius, 0.0, 0.0, 2.0 * kPi)); },
+          [&](const CircularLoop& l) { out.push_back(ring(l.centre, l.axis, x_axis, l.radius, 0.0, 2.0 * kPi)); },
           [&](const StraightSegment& s) { out.push_back({s.a, s.b}); },
-          [&](const Arc& a) {
-            Vec3 u, v, w;
-            frame(a.axis, a.start, u, v, w);
-            std::vector<Vec3> pts;
-            const int n = std::max(2, static_cast<int>(std::ceil(kSides * std::fabs(a.angle) / (2.0 * kPi))));
-            for (int i = 0; i <= n; ++i) {
-              const double t = a.angle * i / n;
-              pts.push_back(a.centre + a.radius * (std::cos(t) * u + std::sin(t) * v));
-            }
-            out.push_back(pts);
-          },
+          [&](const Arc& a) { out.push_back(ring(a.centre, a.axis, a.start, a.radius, 0.0, a.angle)); },
           [&](const Solenoid& s) {
             for (int i = 0; i <= 8; ++i)
-              out.push_back(ring(s.centre, s.axis, s.radius, s.length * (i / 8.0 - 0.5), 0.0, 2.0 * kPi));
+              out.push_back(ring(s.centre, s.axis, x_axis, s.radius, s.length * (i / 8.0 - 0.5), 2.0 * kPi));
           },
           [&](const CircularCoil& c) {
             for (double z : {-0.5 * c.length, 0.5 * c.length})
               for (double r : {c.inner_radius, c.outer_radius})
-                if (r > 0.0) out.push_back(ring(c.centre, c.axis, r, z, 0.0, 2.0 * kPi));
+                if (r > 0.0) out.push_back(ring(c.centre, c.axis, x_axis, r, z, 2.0 * kPi));
           },
           [&](const RoundedRectangleCoil& c) {
             Vec3 u, v, w;
