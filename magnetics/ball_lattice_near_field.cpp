@@ -75,6 +75,20 @@
 // there share, computed once per ball (CuboidCornerTerms); build evaluates
 // every pair with its gradient, and add_forces reuses that at unchanged poses.
 // Pairs in a fixed order, summed on one thread.
+//
+// Carried-over pairs: a ball's pairs with a lattice body (PairGroup) are kept
+// from build to build. While the ball's centre stays within kReuseTolerance R
+// of the point q0 where they were evaluated (in the body's frame, the frame
+// not turned), each pair is carried to its new offset r = r0 + dr to first
+// order, w = w0 + grad w . dr and T_c = T_c0 + (dT_c/dr) dr, with the point
+// dipole's T(r; s) exact, and the gradients as at r0. Since T_c varies on the
+// scale of delta >= kFadeEnd R, the fields (and the energy) are off by
+// O((dr / delta)^2) <= ~1e-8 and the forces by O(dr / delta) <= ~1e-4 of the
+// correction (measured at 0.9 tolerance: 1.0e-10 and 1.2e-5 of a touching
+// ball's field and force): far below the near field's own error (~1e-3). A
+// ball that hangs or rests against a magnet moves nanometres per substep in its
+// frame, so most of its pairs skip the corner terms (ball chain: T_m median
+// 0.050 -> 0.040 ms from 1e-5 to 1e-4 R; docs/benchmarks.md 1f).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
@@ -99,6 +113,9 @@ constexpr double kFadeStart = 0.75;  // above: full correction
 // Lattice bodies need cells spread in 3 dimensions to take a pure torque:
 // smallest eigenvalue of J above this times h^2.
 constexpr double kMinCoupleInertia = 0.1;
+// A ball's pairs are carried over from the last evaluation while its centre
+// stays within this many R of where they were evaluated (lattice body frame).
+constexpr double kReuseTolerance = 1e-4;
 
 // C2 step S(t) = t^3 (10 - 15 t + 6 t^2) on [0, 1], clamped; slope dS/dt.
 double quintic_step(double t, double& slope) {
@@ -349,11 +366,26 @@ struct LatticeBody {
 struct BallCellPair {
   int ball = -1, lattice = -1;  // indices into balls_, cached_
   int b = -1, c = -1;           // cells
+  bool responsive_b = false, responsive_c = false;  // their bodies respond to fields
+  double volume_b = 0.0, volume_c = 0.0;            // their cell volumes (moments V M)
   Vec3 half;                    // half extents of the cell's cuboid (body frame)
   double volume = 0.0;          // V of T_c
   double K[6];                  // world, 1/m^3
   Vec3 r;                       // x_b - x_c at build
   PairGeometry geometry;        // at r, with the gradients (reused by add_forces)
+  Vec3 r0;                      // x_b - x_c where `base` was evaluated
+  PairGeometry base;            // evaluated at r0 (PairGroup)
+};
+
+// A ball's pairs with one lattice body, kept from build to build: while the
+// ball's centre stays within kReuseTolerance R of q0 in the body's frame and
+// the frame has not turned, the pairs are those evaluated at q0, carried to
+// the new offset to first order (header comment).
+struct PairGroup {
+  bool valid = false;
+  Vec3 q0;  // ball centre in the lattice body's frame at the evaluation
+  Mat3 R0;  // the lattice body's rotation then
+  std::vector<BallCellPair> pairs;
 };
 
 bool same(const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
@@ -369,7 +401,7 @@ class BallLatticeNearField final : public NearFieldTerm {
   void build(const MagneticModel& model, const MagneticState& state) override {
     balls_.clear();
     lattices_.clear();
-    pairs_.clear();
+    active_groups_.clear();
     if (model.intra_body_tensor() != IntraBodyTensor::cell_average) return;
     if (model.generation() != cached_generation_ || cached_bodies_ != model.body_count()) cache_lattices(model);
     for (int bi = 0; bi < model.body_count(); ++bi) {
@@ -398,10 +430,26 @@ class BallLatticeNearField final : public NearFieldTerm {
       for (int li : lattices_) {
         LatticeBody& lb = cached_[li];
         if (norm(xb - lb.centroid) >= lb.radius + kCutoffEnd * lb.h) continue;
-        const MagneticBody& body = model.body(lb.body);
         const Mat3& R_X = lb.rotation;
+        const Vec3 q = R_X.transpose_times(xb - state.pose[lb.body].position);
+        const std::size_t gi = static_cast<std::size_t>(ball.body) * cached_.size() + li;
+        PairGroup& group = groups_[gi];
+        active_groups_.push_back(gi);
+        if (group.valid && same(R_X, group.R0) && norm(q - group.q0) <= kReuseTolerance * ball.radius) {
+          for (BallCellPair& p : group.pairs) {
+            p.ball = bi;
+            p.r = xb - state.cell_position[p.c];
+            carry_to(p.r - p.r0, p.base, p.geometry);
+            set_K(model, p);
+          }
+          continue;
+        }
+        group.valid = true;
+        group.q0 = q;
+        group.R0 = R_X;
+        group.pairs.clear();
+        const MagneticBody& body = model.body(lb.body);
         if (lb.shared) {
-          const Vec3 q = R_X.transpose_times(xb - state.pose[lb.body].position);
           lb.corners.begin(q);
           lb.corners.cells_near(q, kCutoffEnd * lb.h, near);
         } else {
@@ -423,49 +471,54 @@ class BallLatticeNearField final : public NearFieldTerm {
             cuboid_corner_terms(l, p.half, true, t);
           pair_tensor(t, R_X, p.volume, true, p.geometry);
           p.ball = bi, p.lattice = li, p.b = ball.cell, p.c = c;
-          const double s = model.cell_contact_radius(ball.cell) + model.cell_contact_radius(c);
-          double dipole[6];
-          dipole_tensor(p.r, s * s, dipole);
-          for (int m = 0; m < 6; ++m) p.K[m] = p.geometry.w * (p.geometry.Tc[m] - dipole[m]);
-          pairs_.push_back(p);
+          p.responsive_b = model.body(ball.body).responsive();
+          p.responsive_c = model.body(lb.body).responsive();
+          p.volume_b = model.cell_volume(p.b);
+          p.volume_c = model.cell_volume(p.c);
+          p.r0 = p.r;
+          p.base = p.geometry;
+          set_K(model, p);
+          group.pairs.push_back(p);
         }
       }
     }
   }
 
-  void add_field(const MagneticModel& model, const MagneticState& state, NearFieldSources sources,
+  void add_field(const MagneticModel& /*model*/, const MagneticState& state, NearFieldSources sources,
                  std::vector<Vec3>& H) const override {
     const bool responsive_sources = sources == NearFieldSources::responsive;
-    for (const BallCellPair& p : pairs_) {
-      const bool resp_b = model.body(balls_[p.ball].body).responsive();
-      const bool resp_c = model.body(cached_[p.lattice].body).responsive();
-      if (resp_b && resp_c == responsive_sources) H[p.b] += symmetric_times(p.K, moment(model, state, p.c));
-      if (resp_c && resp_b == responsive_sources) H[p.c] += symmetric_times(p.K, moment(model, state, p.b));
-    }
+    for_each_pair([&](const BallCellPair& p) {
+      if (p.responsive_b && p.responsive_c == responsive_sources)
+        H[p.b] += symmetric_times(p.K, p.volume_c * state.magnetization[p.c]);
+      if (p.responsive_c && p.responsive_b == responsive_sources)
+        H[p.c] += symmetric_times(p.K, p.volume_b * state.magnetization[p.b]);
+    });
   }
 
   void add_forces(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& force,
                   std::vector<Vec3>& field) const override {
     std::vector<Vec3> torque(cached_.size());
-    for (const BallCellPair& p : pairs_) {
+    for_each_pair([&](const BallCellPair& p) {
       const LatticeBody& lb = cached_[p.lattice];
-      const Vec3 mu_b = moment(model, state, p.b), mu_c = moment(model, state, p.c);
+      const Vec3 mu_b = p.volume_b * state.magnetization[p.b], mu_c = p.volume_c * state.magnetization[p.c];
       const Vec3 r = state.cell_position[p.b] - state.cell_position[p.c];
       const Mat3& R_X = state.pose[lb.body].rotation;
       // The geometry of build where nothing has moved since (the usual case:
       // the backends build at begin_step and take forces at the same poses).
-      const PairGeometry g = same(r, p.r) && same(R_X, lb.rotation)
-                                 ? p.geometry
-                                 : pair_geometry(r, R_X, lb.h, p.half, p.volume, balls_[p.ball].radius, true);
-      if (g.w == 0.0) continue;
+      PairGeometry moved;
+      const bool unmoved = same(r, p.r) && same(R_X, lb.rotation);
+      if (!unmoved) moved = pair_geometry(r, R_X, lb.h, p.half, p.volume, balls_[p.ball].radius, true);
+      const PairGeometry& g = unmoved ? p.geometry : moved;
+      if (g.w == 0.0) return;
       const double s = model.cell_contact_radius(p.b) + model.cell_contact_radius(p.c);
+      const DipoleCoefficients dc = dipole_coefficients(dot(r, r), s * s);
       const Vec3 Tc_mu_c = symmetric_times(g.Tc, mu_c), Tc_mu_b = symmetric_times(g.Tc, mu_b);
-      const Vec3 T_mu_c = dipole_field(r, mu_c, s * s), T_mu_b = dipole_field(r, mu_b, s * s);
+      const Vec3 T_mu_c = dipole_field(dc, r, mu_c), T_mu_b = dipole_field(dc, r, mu_b);
       const double phi0 = dot(mu_b, Tc_mu_c - T_mu_c);
       Vec3 g_c;  // grad_r (mu_b . T_c mu_c)
       for (int k = 0; k < 3; ++k) g_c[k] = dot(mu_b, symmetric_times(g.dTc[k], mu_c));
       // F_b = mu0 grad_r (w phi0); dipole_force is mu0 grad_r (mu_b . T mu_c).
-      const Vec3 F_b = kMu0 * (phi0 * g.grad_w + g.w * g_c) - g.w * dipole_force(r, mu_c, mu_b, s * s);
+      const Vec3 F_b = kMu0 * (phi0 * g.grad_w + g.w * g_c) - g.w * dipole_force(dc, r, mu_c, mu_b);
       force[p.b] += F_b;
       force[p.c] -= F_b;
       field[p.b] += g.w * (Tc_mu_c - T_mu_c);
@@ -473,7 +526,7 @@ class BallLatticeNearField final : public NearFieldTerm {
       // The lattice frame's pure torque (header comment).
       torque[p.lattice] -= kMu0 * (cross(r, (phi0 * g.w_out) * g.grad_w_in + g.w * g_c) +
                                    g.w * (cross(mu_b, Tc_mu_c) + cross(mu_c, Tc_mu_b)));
-    }
+    });
     for (int li : lattices_) {
       const Vec3& tau = torque[li];
       if (tau.x == 0.0 && tau.y == 0.0 && tau.z == 0.0) continue;
@@ -489,19 +542,50 @@ class BallLatticeNearField final : public NearFieldTerm {
 
   double energy(const MagneticModel& model, const MagneticState& state) const override {
     double e = 0.0;
-    for (const BallCellPair& p : pairs_)
+    for_each_pair([&](const BallCellPair& p) {
       e -= kMu0 * dot(moment(model, state, p.b), symmetric_times(p.K, moment(model, state, p.c)));
+    });
     return e;
   }
 
-  int pair_count() const override { return static_cast<int>(pairs_.size()); }
+  int pair_count() const override {
+    int n = 0;
+    for (std::size_t gi : active_groups_) n += static_cast<int>(groups_[gi].pairs.size());
+    return n;
+  }
 
  private:
+  // Every pair of the current build: groups in ball order, then lattice body
+  // order, each group's pairs in cell order.
+  template <class F>
+  void for_each_pair(F&& f) const {
+    for (std::size_t gi : active_groups_)
+      for (const BallCellPair& p : groups_[gi].pairs) f(p);
+  }
+
+  // K = w (T_c - T(r; s)) at the pair's geometry and r.
+  static void set_K(const MagneticModel& model, BallCellPair& p) {
+    const double s = model.cell_contact_radius(p.b) + model.cell_contact_radius(p.c);
+    double dipole[6];
+    dipole_tensor(p.r, s * s, dipole);
+    for (int m = 0; m < 6; ++m) p.K[m] = p.geometry.w * (p.geometry.Tc[m] - dipole[m]);
+  }
+
+  // The geometry at r0 + dr from the one at r0: w and T_c to first order in
+  // dr, their gradients (and w_out, w_in) as at r0.
+  static void carry_to(const Vec3& dr, const PairGeometry& base, PairGeometry& g) {
+    g = base;
+    g.w = base.w + dot(base.grad_w, dr);
+    for (int m = 0; m < 6; ++m)
+      g.Tc[m] = base.Tc[m] + base.dTc[0][m] * dr.x + base.dTc[1][m] * dr.y + base.dTc[2][m] * dr.z;
+  }
+
   // The model-only data of every lattice body with at least three cells spread
   // in three dimensions (the frame couple needs them), not graded (graded
   // cells stay point dipoles: lattice_near_field.cpp) and not inert.
   void cache_lattices(const MagneticModel& model) {
     cached_.clear();
+    groups_.clear();
     cached_generation_ = model.generation();
     cached_bodies_ = model.body_count();
     for (int bi = 0; bi < model.body_count(); ++bi) {
@@ -538,6 +622,7 @@ class BallLatticeNearField final : public NearFieldTerm {
       lb.shared = lb.corners.build(lower, upper, lb.h);
       cached_.push_back(std::move(lb));
     }
+    groups_.assign(static_cast<std::size_t>(model.body_count()) * cached_.size(), {});
   }
 
   static Vec3 moment(const MagneticModel& model, const MagneticState& state, int cell) {
@@ -570,7 +655,10 @@ class BallLatticeNearField final : public NearFieldTerm {
   uint64_t cached_generation_ = 0;
   int cached_bodies_ = -1;
   std::vector<int> lattices_;  // the active ones at build, indices into cached_
-  std::vector<BallCellPair> pairs_;
+  // Per (ball body, cached lattice body): groups_[ball * cached_.size() + li],
+  // kept across builds; those of the current build in active_groups_.
+  std::vector<PairGroup> groups_;
+  std::vector<std::size_t> active_groups_;
 };
 
 }  // namespace

@@ -53,17 +53,22 @@ ODEMAG_HD DipoleCoefficients dipole_coefficients(double r2, double s2) {
   return dipole_coefficients_from(r2, 1.0 / sqrt(r2 > s2 ? r2 : s2));
 }
 
-// Field H (A/m) at offset r from a moment mu (A m^2): T(r) mu.
-ODEMAG_HD Vec3 dipole_field(const Vec3& r, const Vec3& mu, double s2) {
-  const DipoleCoefficients c = dipole_coefficients(dot(r, r), s2);
+// Field H (A/m) at offset r from a moment mu (A m^2): T(r) mu, with the
+// pair's coefficients c at r.
+ODEMAG_HD Vec3 dipole_field(const DipoleCoefficients& c, const Vec3& r, const Vec3& mu) {
   return c.A * mu + (c.B * dot(r, mu)) * r;
+}
+ODEMAG_HD Vec3 dipole_field(const Vec3& r, const Vec3& mu, double s2) {
+  return dipole_field(dipole_coefficients(dot(r, r), s2), r, mu);
 }
 
 // Force (N) on moment mu_b from moment mu_a, r = x_b - x_a.
-ODEMAG_HD Vec3 dipole_force(const Vec3& r, const Vec3& mu_a, const Vec3& mu_b, double s2) {
-  const DipoleCoefficients c = dipole_coefficients(dot(r, r), s2);
+ODEMAG_HD Vec3 dipole_force(const DipoleCoefficients& c, const Vec3& r, const Vec3& mu_a, const Vec3& mu_b) {
   const double ra = dot(r, mu_a), rb = dot(r, mu_b);
   return kMu0 * (c.B * (ra * mu_b + rb * mu_a + dot(mu_a, mu_b) * r) + (c.C * ra * rb) * r);
+}
+ODEMAG_HD Vec3 dipole_force(const Vec3& r, const Vec3& mu_a, const Vec3& mu_b, double s2) {
+  return dipole_force(dipole_coefficients(dot(r, r), s2), r, mu_a, mu_b);
 }
 
 // Torque (N m) about a body's centre of mass of one of its cells at offset
