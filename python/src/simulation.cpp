@@ -165,6 +165,7 @@ class PySimulation {
     d["time"] = double_array(column(&StepRecord::time));
     d["magnetic_ms"] = double_array(column(&StepRecord::magnetic_ms));
     d["rigid_ms"] = double_array(column(&StepRecord::rigid_ms));
+    d["wall_ms"] = double_array(column(&StepRecord::wall_ms));
     d["substeps"] = copied_array<int>(column(&StepRecord::substeps));
     d["substeps_wanted"] = copied_array<int>(column(&StepRecord::substeps_wanted));
     d["iterations"] = copied_array<int>(column(&StepRecord::iterations));
