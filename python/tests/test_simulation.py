@@ -2,6 +2,8 @@
 state and the same outcomes, bit for bit; the state and per-step arrays."""
 
 import json
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -149,3 +151,20 @@ def test_simulations_in_one_process_do_not_share_odes_random_numbers(tmp_path):
         other.step()
     np.testing.assert_array_equal(sim.positions, np.array([b["position"] for b in last["bodies"]]))
     assert sim.finish() == summary["outcomes"]
+
+
+def test_run_releases_the_gil():
+    # Another Python thread keeps running while run() is in C++: the longest
+    # pause of its loop is a fraction of the run's time (with the GIL held
+    # it would be all of it).
+    sim = odemag.Simulation(odemag.load(ROOT / "demos/scenes/ball_chain.json"), threads=1)
+    done = threading.Event()
+    worker = threading.Thread(target=lambda: (sim.run(), done.set()))
+    ticks = [time.perf_counter()]
+    worker.start()
+    while not done.is_set():
+        ticks.append(time.perf_counter())
+    worker.join()
+    total = ticks[-1] - ticks[0]
+    assert sim.steps > 0 and total > 0.05
+    assert max(np.diff(ticks)) < 0.5 * total
