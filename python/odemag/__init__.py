@@ -28,6 +28,10 @@ Attributes: file (the path, or "<dict>" / "<string>" / the name given to
 load), key (the scene key path, e.g. "bodies[2].shape.sphere"; "" when the
 error is about the whole file, such as malformed JSON before any key) and
 message (what is wrong)."""
+# Defaults for a SceneError raised from Python code with only a message.
+SceneError.file = ""
+SceneError.key = ""
+SceneError.message = ""
 
 
 def _plain(value):
