@@ -1,6 +1,8 @@
 """Scene.solve and Scene.field against `odemag solve` and `odemag field`:
 the same doubles, bit for bit (the program prints round-trip precision)."""
 
+import json
+
 import numpy as np
 import pytest
 
@@ -66,3 +68,19 @@ def test_field_of_the_examples_points_file():
     B, H = odemag.load(path).field(rows[:, 0:3])
     np.testing.assert_array_equal(B, rows[:, 3:6])
     np.testing.assert_array_equal(H, rows[:, 6:9])
+
+
+def test_dict_text_and_path_load_the_same_scene():
+    path = ROOT / "examples/two_magnets.json"
+    text = path.read_text()
+    by_path, by_str = odemag.load(path).solve(), odemag.load(str(path)).solve()
+    by_dict, by_text = odemag.load(json.loads(text)).solve(), odemag.load(text).solve()
+    for other in (by_str, by_dict, by_text):
+        np.testing.assert_array_equal(other.forces, by_path.forces)
+    assert odemag.load(json.loads(text)).file == "<dict>" and odemag.load(text).file == "<string>"
+    assert odemag.load(path).file == str(path)
+
+
+def test_field_of_no_points():
+    field = odemag.load(ROOT / "examples/bar_and_ball.json").field(np.zeros((0, 3)))
+    assert field.B.shape == (0, 3) and field.H.shape == (0, 3) and field.B.dtype == np.float64
