@@ -34,6 +34,16 @@ SceneError.key = ""
 SceneError.message = ""
 
 
+def _scene_error(text, file, key, message):
+    error = SceneError(text)
+    error.file, error.key, error.message = file, key, message
+    return error
+
+
+# Pickled with its attributes (errors coming back from worker processes).
+SceneError.__reduce__ = lambda self: (_scene_error, (str(self), self.file, self.key, self.message))
+
+
 def _plain(value):
     """json.dumps' fallback: numpy scalars and arrays as Python numbers and lists."""
     if hasattr(value, "tolist"):

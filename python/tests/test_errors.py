@@ -3,6 +3,7 @@ message `odemag` prints, and the file and key as attributes."""
 
 import copy
 import json
+import pickle
 
 import numpy as np
 import pytest
@@ -64,6 +65,15 @@ def test_malformed_json_names_file_and_key(tmp_path):
     assert caught.value.key == "bodies[1].position"  # the value being read when the text ends
     assert caught.value.message.startswith("invalid JSON: ")
     assert str(caught.value) == cli_error("solve", path)
+
+
+def test_scene_error_pickles_with_its_attributes():
+    with pytest.raises(odemag.SceneError) as caught:
+        odemag.load(CASES[0][1])
+    copy_ = pickle.loads(pickle.dumps(caught.value))
+    assert type(copy_) is odemag.SceneError
+    assert (str(copy_), copy_.file, copy_.key, copy_.message) == (
+        str(caught.value), "<dict>", "bodies[1].colour", caught.value.message)
 
 
 def test_missing_file(tmp_path):
