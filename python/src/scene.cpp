@@ -155,6 +155,29 @@ void bind_scene(py::module_& m) {
   scene_error_type = py::exception<SceneError>(m, "SceneError", PyExc_ValueError).release().ptr();
   py::register_exception_translator(translate_scene_error);
 
+  py::class_<Solution>(m, "Solution", "Scene.solve's result (docs/python.md).")
+      .def_readonly("body_names", &Solution::body_names)
+      .def_readonly("present", &Solution::present, "(B,) bool: present at t = 0 (absent bodies report zeros)")
+      .def_readonly("cells", &Solution::cells, "(B,) int32: cells per body")
+      .def_readonly("moments", &Solution::moments, "(B, 3) float64: magnetic moments, A m^2, world frame")
+      .def_readonly("forces", &Solution::forces, "(B, 3) float64: magnetic forces, N, world frame")
+      .def_readonly("torques", &Solution::torques, "(B, 3) float64: torques about the centres of mass, N m")
+      .def_readonly("iterations", &Solution::iterations)
+      .def_readonly("field_evaluations", &Solution::field_evaluations)
+      .def_readonly("residual", &Solution::residual)
+      .def_readonly("converged", &Solution::converged)
+      .def_readonly("backend", &Solution::backend);
+
+  py::class_<Field>(m, "Field", "Scene.field's result (docs/python.md); unpacks as B, H.")
+      .def_readonly("points", &Field::points, "(N, 3) float64: the points, m")
+      .def_readonly("B", &Field::B, "(N, 3) float64: flux density, T")
+      .def_readonly("H", &Field::H, "(N, 3) float64: field strength, A/m")
+      .def_readonly("iterations", &Field::iterations)
+      .def_readonly("residual", &Field::residual)
+      .def_readonly("converged", &Field::converged)
+      .def_readonly("backend", &Field::backend)
+      .def("__iter__", [](const Field& f) { return py::iter(py::make_tuple(f.B, f.H)); });
+
   py::class_<SceneDescription, std::shared_ptr<SceneDescription>>(m, "Scene",
       "A validated scene (docs/scene-format.md); made by odemag.load.")
       .def_readonly("file", &SceneDescription::file, "where the scene came from, as named in messages")
@@ -168,31 +191,13 @@ void bind_scene(py::module_& m) {
                              "simulation.time_step, s")
       .def_property_readonly("duration", [](const SceneDescription& s) { return s.simulation.duration; },
                              "simulation.duration, s")
-      .def("solve", &solve, py::arg("backend") = py::none(), py::arg("threads") = py::none())
-      .def("field", &field, py::arg("points"), py::arg("backend") = py::none(), py::arg("threads") = py::none());
-
-  py::class_<Solution>(m, "Solution", "Scene.solve's result (docs/python.md).")
-      .def_readonly("body_names", &Solution::body_names)
-      .def_readonly("present", &Solution::present)
-      .def_readonly("cells", &Solution::cells)
-      .def_readonly("moments", &Solution::moments)
-      .def_readonly("forces", &Solution::forces)
-      .def_readonly("torques", &Solution::torques)
-      .def_readonly("iterations", &Solution::iterations)
-      .def_readonly("field_evaluations", &Solution::field_evaluations)
-      .def_readonly("residual", &Solution::residual)
-      .def_readonly("converged", &Solution::converged)
-      .def_readonly("backend", &Solution::backend);
-
-  py::class_<Field>(m, "Field", "Scene.field's result (docs/python.md); unpacks as B, H.")
-      .def_readonly("points", &Field::points)
-      .def_readonly("B", &Field::B)
-      .def_readonly("H", &Field::H)
-      .def_readonly("iterations", &Field::iterations)
-      .def_readonly("residual", &Field::residual)
-      .def_readonly("converged", &Field::converged)
-      .def_readonly("backend", &Field::backend)
-      .def("__iter__", [](const Field& f) { return py::iter(py::make_tuple(f.B, f.H)); });
+      .def("solve", &solve, py::arg("backend") = py::none(), py::arg("threads") = py::none(),
+           "`odemag solve`: the scene at t = 0 relaxed with its bodies held in place, with forces and\n"
+           "torques. backend ('cpu', 'cuda', 'auto') and threads (0: all cores) override solver.backend\n"
+           "and solver.threads. Returns a Solution (per-body (B, 3) arrays in A m^2, N, N m).")
+      .def("field", &field, py::arg("points"), py::arg("backend") = py::none(), py::arg("threads") = py::none(),
+           "`odemag field`: B (T) and H (A/m) at points, an (N, 3) array in m, of the scene relaxed as\n"
+           "in solve. Returns a Field (B, H: (N, 3) float64); unpacks as B, H.");
 
   m.def("load_file", [](const std::string& path) { return std::make_shared<SceneDescription>(load_scene(path)); },
         py::arg("path"), py::call_guard<py::gil_scoped_release>());
