@@ -17,6 +17,7 @@ packages=(
   libode-dev libeigen3-dev libosmesa6-dev libpng-dev nlohmann-json3-dev
   libfreetype-dev fonts-dejavu-core
   libgtest-dev libbenchmark-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-pyode  # the Python package and its tests (docs/python.md)
   gnuplot-nox
   "${sanitize_packages[@]}"
   "$@"

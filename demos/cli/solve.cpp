@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -11,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "demos/cli/cli.h"
-#include "engine/sim/magnetic_system.h"
+#include "engine/sim/solve.h"
 #include "engine/scene/scene.h"
 #include "magnetics/relax.h"
 
@@ -76,12 +77,11 @@ class SolveProgress {
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now(), shown_{};
 };
 
-// The scene's relaxation options at t = 0, with the progress lines.
-RelaxOptions start_options(const SceneDescription& scene, MagneticSystem& system) {
-  RelaxOptions o = scene.solver.relax;
-  apply_events_at_start(scene, system, o);
-  o.progress = SolveProgress(o.tolerance, o.max_iterations);
-  return o;
+// A double as the shortest text that reads back as the same double.
+std::string round_trip(double x) {
+  char text[64];
+  const std::to_chars_result r = std::to_chars(text, text + sizeof text, x);
+  return std::string(text, r.ptr);
 }
 
 std::string number(double x) { return nlohmann::json(x).dump(); }
@@ -156,27 +156,23 @@ int run_solve(const std::vector<std::string>& args) {
   const SolveOptions& options = c.solve;
   const SceneDescription scene = load_scene(c.scene);
   check_cell_pairs(scene, options);
-  MagneticSystem ms = build_magnetic_system(scene);
-  const RelaxOptions relax_options = start_options(scene, ms);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
-  const RelaxReport report = magnetic_step(ms.model, ms.state, relax_options, *backend);
+  const RelaxOptions& relax_options = scene.solver.relax;
+  const SceneSolution solution =
+      solve_scene(scene, *backend, SolveProgress(relax_options.tolerance, relax_options.max_iterations));
+  const RelaxReport& report = solution.report;
 
   // One line per body, in scene order; bodies not present report zeros.
   bool finite = !std::isnan(report.residual);
   std::string out = "{\n  \"bodies\": [";
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
-    const int i = static_cast<int>(b);
-    const bool present = ms.state.active[b] != 0;
-    const Vec3 moment = present ? body_moment(ms.model, ms.state, i) : Vec3{};
-    const Vec3 force = present ? ms.state.force[b] : Vec3{};
-    const Vec3 torque = present ? ms.state.torque[b] : Vec3{};
-    finite = finite && is_finite(moment) && is_finite(force) && is_finite(torque);
+    const SolvedBody& body = solution.bodies[b];
+    finite = finite && is_finite(body.moment) && is_finite(body.force) && is_finite(body.torque);
     out += b == 0 ? "\n    " : ",\n    ";
     out += "{\"name\": " + nlohmann::json(scene.bodies[b].name).dump() +
-           ", \"present\": " + (present ? "true" : "false") +
-           ", \"cells\": " + std::to_string(ms.model.body(i).cell_count()) +
-           ", \"moment\": " + vector(moment) + ", \"force\": " + vector(force) +
-           ", \"torque\": " + vector(torque) + "}";
+           ", \"present\": " + (body.present ? "true" : "false") +
+           ", \"cells\": " + std::to_string(body.cells) + ", \"moment\": " + vector(body.moment) +
+           ", \"force\": " + vector(body.force) + ", \"torque\": " + vector(body.torque) + "}";
   }
   require_finite(scene, finite);
   out += "\n  ],\n";
@@ -197,25 +193,25 @@ int run_field(const std::vector<std::string>& args) {
   const SceneDescription scene = load_scene(c.scene);
   check_cell_pairs(scene, options);
   const std::vector<Vec3> points = read_points(c.points);
-  MagneticSystem ms = build_magnetic_system(scene);
-  const RelaxOptions relax_options = start_options(scene, ms);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
-  const RelaxReport report = relax(ms.model, ms.state, relax_options, *backend);
-  std::vector<Vec3> B, H;
-  field_at_points(ms.model, ms.state, *backend, points, B, H);
+  const RelaxOptions& relax_options = scene.solver.relax;
+  const SceneField field =
+      scene_field(scene, *backend, points, SolveProgress(relax_options.tolerance, relax_options.max_iterations));
 
+  // Every number with round-trip precision: reading the CSV back gives the doubles computed.
   bool finite = true;
   std::string out = "x,y,z,Bx,By,Bz,Hx,Hy,Hz\n";
-  char row[512];
   for (size_t p = 0; p < points.size(); ++p) {
-    finite = finite && is_finite(B[p]) && is_finite(H[p]);
-    const Vec3 &x = points[p], &b = B[p], &h = H[p];
-    std::snprintf(row, sizeof row, "%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g\n", x.x, x.y,
-                  x.z, b.x, b.y, b.z, h.x, h.y, h.z);
-    out += row;
+    const Vec3 &x = points[p], &b = field.B[p], &h = field.H[p];
+    finite = finite && is_finite(b) && is_finite(h);
+    const double row[9] = {x.x, x.y, x.z, b.x, b.y, b.z, h.x, h.y, h.z};
+    for (int k = 0; k < 9; ++k) {
+      out += round_trip(row[k]);
+      out += k < 8 ? ',' : '\n';
+    }
   }
   require_finite(scene, finite);
-  warn_if_not_converged(scene, report);
+  warn_if_not_converged(scene, field.report);
   write_stdout(out);
   return 0;
 }

@@ -1488,8 +1488,8 @@ SceneDescription parse_scene(const std::string& json_text, const std::string& fi
     const std::string what = without_exception_tag(tracker.error().value_or("syntax error"));
     // 406: a number too large for a double (1e999); JSON has no infinity.
     if (tracker.error_id() == 406) throw SceneError(file, tracker.path(), what + " (numbers must be finite)");
-    const std::string where = tracker.path();
-    throw SceneError(file, "", "invalid JSON: " + what + (where.empty() ? "" : " (while reading " + where + ")"));
+    // The key being read when the text broke off: "FILE: bodies[1].position: invalid JSON: ...".
+    throw SceneError(file, tracker.path(), "invalid JSON: " + what);
   }
   json root;
   try {

@@ -187,6 +187,12 @@ void RigidWorld::update_forces(double time, double dt) {
 void RigidWorld::integrate(double h) {
   for (ForceAccumulator* a : accumulators_) a->add_forces();
   for (Body& b : bodies_) b.in_contact = false, b.contacts = 0;
+  // ODE's random numbers (dWorldQuickStep reorders constraints randomly) come
+  // from one seed per process: each world keeps its own sequence, so a run
+  // does not depend on the worlds stepped before it in the same process (a
+  // Python session, a sweep worker) and matches a fresh `odemag run`.
+  const unsigned long process_seed = dRandGetSeed();
+  dRandSetSeed(random_seed_);
   dSpaceCollide(space_, this, &RigidWorld::near_callback);
   if (exact_solver_) {
     dWorldStep(world_, h);
@@ -194,6 +200,8 @@ void RigidWorld::integrate(double h) {
     dWorldQuickStep(world_, h);
   }
   dJointGroupEmpty(contacts_);
+  random_seed_ = dRandGetSeed();
+  dRandSetSeed(process_seed);
 }
 
 void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {

@@ -86,6 +86,9 @@ class RigidWorld {
   std::vector<ForceAccumulator*> accumulators_;
   ContactSettings contact_;
   bool exact_solver_ = false;
+  // This world's state of ODE's random number generator (integrate); ODE's
+  // initial seed, so that the first world of a process steps as before.
+  unsigned long random_seed_ = 0;
 };
 
 }  // namespace odemag

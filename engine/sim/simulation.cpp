@@ -159,6 +159,7 @@ void Simulation::update_substeps(double dt, bool step_start, StepRecord& record)
 
 void Simulation::step() {
   if (non_finite_body_ >= 0) throw std::runtime_error(non_finite_message());
+  const auto started = std::chrono::steady_clock::now();
   const double dt = scene_.simulation.time_step;
   apply_timeline(dt);
   StepRecord record;
@@ -213,6 +214,7 @@ void Simulation::step() {
   time_ += dt;
   ++steps_;
   outcomes_.sample(scene_, time_, dt, *world_, *magnetics_);
+  records_.back().wall_ms = elapsed_ms(started);
 }
 
 void Simulation::advance_to(double t) {

@@ -20,6 +20,7 @@ struct StepRecord {
   double time = 0.0;         // at the start of the step, s
   double magnetic_ms = 0.0;  // T_m: relaxation, forces and torques
   double rigid_ms = 0.0;     // T_r: collision, dWorldQuickStep, contacts
+  double wall_ms = 0.0;      // the whole step(): time line, T_m, T_r, substep rule, outcomes
   int substeps = 1;          // substeps, each with its own relaxation and collision check
   // The most substeps the substep rule asked for during the step; above
   // SimulationSettings::max_substeps its travel and stiffness bounds did not

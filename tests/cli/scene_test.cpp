@@ -268,14 +268,15 @@ TEST(SceneParser, Timeline) {
 
 TEST(SceneParser, RejectsBadJson) {
   const SceneError e = rejection("{\"materials\": {},\n \"bodies\": [1, 2,]}");
-  EXPECT_EQ(e.key(), "");
+  EXPECT_EQ(e.key(), "bodies[2]");  // the value being read where the text breaks
+  EXPECT_EQ(e.message().rfind("invalid JSON: ", 0), 0u) << e.what();
   EXPECT_NE(e.message().find("line 2"), std::string::npos) << e.what();
   EXPECT_NE(e.message().find("column"), std::string::npos) << e.what();
 }
 
 TEST(SceneParser, RejectsNanLiteralAsSyntaxError) {
   const SceneError e = rejection(R"({"gravity": [0, 0, NaN]})");
-  EXPECT_EQ(e.key(), "");
+  EXPECT_EQ(e.key(), "gravity[2]");
   EXPECT_NE(e.message().find("line 1, column"), std::string::npos) << e.what();
 }
 

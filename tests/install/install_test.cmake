@@ -1,5 +1,6 @@
 # cmake -DBUILD_DIR=... -DCONSUMER_SOURCE_DIR=... -DWORK_DIR=... [-DGENERATOR=...]
-#   [-DCXX_COMPILER=...] [-DBUILD_TYPE=...] [-DSANITIZE=...] -P install_test.cmake
+#   [-DCXX_COMPILER=...] [-DBUILD_TYPE=...] [-DSANITIZE=...]
+#   [-DPYTHON=... -DPYTHON_PACKAGE_DIR=... -DSCENE=...] -P install_test.cmake
 # Installs the odemag build in BUILD_DIR into WORK_DIR/prefix, configures and
 # builds the consumer project CONSUMER_SOURCE_DIR against it with
 # find_package(odemag) and runs its embed_minimal; fails on the first step
@@ -28,6 +29,13 @@ function(step name)
 endfunction()
 
 step(install ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix} --config ${BUILD_TYPE})
+# The Python package (docs/python.md), when the build has it: the installed
+# copy imports and solves SCENE.
+if(PYTHON)
+  step(python ${CMAKE_COMMAND} -E env PYTHONPATH=${prefix}/${PYTHON_PACKAGE_DIR} ${PYTHON} -c
+       "import sys, odemag; assert odemag.__file__.startswith(sys.argv[1]), odemag.__file__; assert odemag.load(sys.argv[2]).solve().forces.shape == (2, 3)"
+       ${prefix}/${PYTHON_PACKAGE_DIR} ${SCENE})
+endif()
 foreach(file include/odemag/engine/ode/magnetic_forces.h include/odemag/engine/scene/scene.h
         include/odemag/engine/sim/simulation.h include/odemag/magnetics/model.h
         include/odemag/gpu/cuda_backend.h bin/odemag)
