@@ -4,6 +4,8 @@
 // other exception: exit 1).
 #pragma once
 
+#include <sys/types.h>
+
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -124,6 +126,21 @@ int run_field(const std::vector<std::string>& args);
 using FrameWriterFactory =
     std::function<std::unique_ptr<FrameWriter>(const SceneDescription& scene)>;
 int run_simulation(const std::vector<std::string>& args, const FrameWriterFactory& frames);
+
+// `odemag sweep SPEC --out DIR ...` (docs/sweeps.md): runs the variants of a
+// sweep spec (engine/scene/sweep.h) and writes DIR/results.csv; also the
+// steps the Dask and Slurm runners call (--expand, --variant I, --gather).
+int run_sweep(const std::vector<std::string>& args, const FrameWriterFactory& frames);
+
+// The numbers of a run's summary.json that a sweep can collect, as key paths
+// ("steps", "magnetic_ms.mean"); run.cpp writes them.
+const std::vector<std::string>& summary_figures();
+
+// Starts the program (argv `args`, without a shell; stdout to /dev/null when
+// quiet_stdout) and returns its pid; wait_program returns its exit status (a
+// signal: 128 + the signal number). Throw std::runtime_error.
+pid_t start_program(const std::string& program, std::vector<std::string> args, bool quiet_stdout = false);
+int wait_program(pid_t pid);
 
 // The text with control characters (newlines included) replaced by spaces:
 // messages on stderr are one line each.
