@@ -301,6 +301,7 @@ int run_variant(const SweepCommandLine& c, const CheckedSweep& cs, const FrameWr
 // list the Dask runner reads.
 void expand(const SweepCommandLine& c, const CheckedSweep& cs) {
   const Sweep& s = cs.sweep;
+  for (size_t i = 0; i < s.size(); ++i) s.variant(i);  // every variant valid before anything is written
   json list = json::array();
   for (size_t i = 0; i < s.size(); ++i) {
     const SweepVariant v = s.variant(i);
@@ -414,12 +415,12 @@ int run_dask(const SweepCommandLine& c) {
 
 // --slurm: a job-array script (one task per variant) and a gather script.
 int write_slurm(const SweepCommandLine& c, const CheckedSweep& cs) {
-  expand(c, cs);
   const std::string out = fs::absolute(c.out).lexically_normal().string();
   const std::string spec = fs::absolute(c.spec).lexically_normal().string();
   for (const std::string& p : {out, spec})
     if (p.find_first_of("% \t\n'") != std::string::npos)
       throw UsageError("--slurm: the path " + p + " has a space, a quote or '%', which #SBATCH lines cannot hold");
+  expand(c, cs);
   const std::string self = self_program(), logs = out + "/slurm";
   std::error_code ec;
   fs::create_directories(logs, ec);

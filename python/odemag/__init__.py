@@ -1,0 +1,1 @@
+# odemag Python package (python/odemag): odemag.sweep runs sweeps on Dask (docs/sweeps.md).
