@@ -18,6 +18,8 @@ packages=(
   libfreetype-dev fonts-dejavu-core
   libgtest-dev libbenchmark-dev
   gnuplot-nox
+  python3-pytest python3-distributed  # the sweep runners' tests (python/tests)
+  slurm-wlm  # python/tests/test_slurm.py starts a single-node Slurm (skips where it cannot)
   "${sanitize_packages[@]}"
   "$@"
 )

@@ -45,9 +45,13 @@ def _odemag(program, args, check=True):
 
 
 def run_variant(program, spec, out, index):
-    """One Dask task: runs variant `index` (reused when finished) and returns (index, CSV row)."""
-    r = _odemag(program, [spec, "--out", out, "--variant", str(index)])
-    return index, r.stdout.strip()
+    """One Dask task: runs variant `index` (reused when finished). Returns
+    (index, its CSV row, ""), or (index, None, the error) when its run failed
+    (the table marks it failed, as the local runner does)."""
+    r = _odemag(program, [spec, "--out", out, "--variant", str(index)], check=False)
+    if r.returncode != 0:
+        return index, None, "exit status %d: %s" % (r.returncode, r.stderr.strip())
+    return index, r.stdout.strip(), ""
 
 
 def _client(dask):
@@ -90,19 +94,21 @@ def sweep(spec, out, client=None, dask="local:2", odemag=None, on_submitted=None
                              pure=False)
         if on_submitted:
             on_submitted(client, futures)
-        rows = dict(client.gather(futures))
+        results = client.gather(futures)
     finally:
         if own:
             own[0].close()
             if own[1] is not None:
                 own[1].close()
-    if sorted(rows) != list(range(count)):
-        raise RuntimeError("the tasks returned variants %s, not 0..%d" % (sorted(rows), count - 1))
+    indices = sorted(index for index, _, _ in results)
+    if indices != list(range(count)):
+        raise RuntimeError("the tasks returned variants %s, not 0..%d" % (indices, count - 1))
     r = _odemag(program, [spec, "--out", out, "--gather", "--quiet", "yes"], check=False)
     with open(os.path.join(out, "results.csv"), newline="") as f:
         table = list(csv.DictReader(f))
-    if r.returncode != 0:
-        raise RuntimeError("odemag sweep --gather: " + r.stderr.strip())
+    failed = ["variant %d: %s" % (index, error) for index, row, error in results if row is None]
+    if failed or r.returncode != 0:
+        raise RuntimeError("; ".join(failed) or "odemag sweep --gather: " + r.stderr.strip())
     return table
 
 

@@ -125,3 +125,20 @@ def test_a_killed_workers_variants_are_run_again(tmp_path, expected):
     while odemag_processes(tmp_path / "out") and time.time() < deadline:
         time.sleep(0.1)
     assert odemag_processes(tmp_path / "out") == []
+
+
+def test_odemag_sweep_dask_gives_the_local_runners_table(tmp_path):
+    spec = write_spec(tmp_path)
+    env = dict(os.environ, PYTHONPATH="")  # odemag finds python/ itself
+    for out, runner in (("local", []), ("dask", ["--dask", "local:2"])):
+        subprocess.run([ODEMAG, "sweep", spec, "--out", str(tmp_path / out), "--quiet", "yes", *runner],
+                       env=env, check=True, timeout=120, stderr=subprocess.DEVNULL)
+    assert (tmp_path / "dask" / "results.csv").read_text() == (tmp_path / "local" / "results.csv").read_text()
+    # A bad spec is named by odemag itself (exit 2) before Python starts.
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"scene": BASE, "grid": {"materials.stel.susceptibility": [1]}}))
+    r = subprocess.run([ODEMAG, "sweep", str(bad), "--out", str(tmp_path / "bad"), "--dask", "local"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2
+    assert r.stderr.startswith("odemag: %s: grid[\"materials.stel.susceptibility\"]: " % bad), r.stderr
+    assert not (tmp_path / "bad").exists()
