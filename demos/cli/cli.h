@@ -100,6 +100,16 @@ struct RunCommandLine {
   // encoded by the ffmpeg program after the run; needs the frames.
   std::optional<std::string> video;
 };
+struct SweepCommandLine {
+  enum class Mode { local, expand, variant, gather, dask, slurm };
+  std::string spec, out;
+  Mode mode = Mode::local;
+  size_t variant = 0;  // --variant I
+  int jobs = 1;        // --jobs N (default: one per core)
+  std::string dask;    // --dask local[:N] | ADDRESS
+  bool quiet = false;
+};
+SweepCommandLine parse_sweep_command(std::vector<std::string> args);
 SolveCommandLine parse_solve_command(const std::vector<std::string>& args);
 FieldCommandLine parse_field_command(const std::vector<std::string>& args);
 RunCommandLine parse_run_command(const std::vector<std::string>& args);

@@ -37,16 +37,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
-struct SweepCommandLine {
-  enum class Mode { local, expand, variant, gather, dask, slurm };
-  std::string spec, out;
-  Mode mode = Mode::local;
-  size_t variant = 0;  // --variant I
-  int jobs = 1;        // --jobs N
-  std::string dask;    // --dask local[:N] | ADDRESS
-  bool quiet = false;
-};
-
 // The step flags take no value (`--expand`), unlike every other option.
 bool take_flag(std::vector<std::string>& args, const std::string& flag) {
   for (size_t i = 0; i < args.size() && args[i] != "--"; ++i)
@@ -56,6 +46,8 @@ bool take_flag(std::vector<std::string>& args, const std::string& flag) {
     }
   return false;
 }
+
+}  // namespace
 
 SweepCommandLine parse_sweep_command(std::vector<std::string> args) {
   SweepCommandLine c;
@@ -85,6 +77,7 @@ SweepCommandLine parse_sweep_command(std::vector<std::string> args) {
   }
   if (const auto d = a.option("dask")) {
     if (d->empty()) throw UsageError("--dask: expected local, local:N or a scheduler address");
+    if (d->rfind("local:", 0) == 0) whole("dask local:N", d->substr(6), 1, 1024);
     modes.push_back(SweepCommandLine::Mode::dask);
     c.dask = *d;
   }
@@ -102,6 +95,8 @@ SweepCommandLine parse_sweep_command(std::vector<std::string> args) {
   }
   return c;
 }
+
+namespace {
 
 std::string file_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
