@@ -358,8 +358,14 @@ int run_local(const SweepCommandLine& c, const CheckedSweep& cs) {
   const Sweep& s = cs.sweep;
   expand(c, cs);
   std::vector<size_t> pending;
-  for (size_t i = 0; i < s.size(); ++i)
-    if (!finished_summary(variant_dir(c, i, s.size()), variant_hash(s.variant(i), cs.run_args))) pending.push_back(i);
+  for (size_t i = 0; i < s.size(); ++i) {
+    const fs::path dir = variant_dir(c, i, s.size());
+    if (finished_summary(dir, variant_hash(s.variant(i), cs.run_args))) continue;
+    pending.push_back(i);
+    std::error_code ec;  // the run folders a crashed or killed sweep left behind
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+      if (e.path().filename().string().rfind(".run-", 0) == 0) fs::remove_all(e.path(), ec);
+  }
   if (!c.quiet)
     std::fprintf(stderr, "odemag sweep: %zu variants, %zu to run (%zu finished before), %d at a time\n", s.size(),
                  pending.size(), s.size() - pending.size(), c.jobs);

@@ -215,6 +215,7 @@ TEST_F(Sweep, TableEqualsTheVariantsRunOneByOneAndResumesWithoutRerunning) {
       }
   for (int i : {0, 1, 3}) EXPECT_EQ(read_file(v / ("000" + std::to_string(i)) / "summary.json"), summaries[i]);
   EXPECT_NE(read_file(v / "0002" / "summary.json"), summaries[2]);
+  EXPECT_FALSE(fs::exists(v / "0002" / ".run-crashed-1"));  // the local runner cleared it
   // A summary for another scene (the spec changed) is not reused.
   const std::string changed = read_file(spec_file);
   write("spec.json", std::string(changed).replace(changed.find("0.1"), 3, "0.2"));
