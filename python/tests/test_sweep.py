@@ -115,10 +115,16 @@ def test_a_killed_workers_variants_are_run_again(tmp_path, expected):
                 killed["worker"], killed["tasks"] = worker, len(processing[worker])
                 os.kill(pids[worker], signal.SIGKILL)
             time.sleep(0.05)
+        # The scheduler counts, per task, the workers that died running it.
+        while time.time() < deadline and killed.get("suspicious", 0) < 1:
+            killed["suspicious"] = client.run_on_scheduler(
+                lambda dask_scheduler: max(ts.suspicious for ts in dask_scheduler.tasks.values()))
+            time.sleep(0.05)
 
     table = sweep(write_spec(tmp_path), tmp_path / "out", dask="local:2", odemag=ODEMAG,
                   on_submitted=kill_a_busy_worker)
     assert killed and killed["tasks"] >= 1
+    assert killed["suspicious"] >= 1  # a variant lost with the worker, run again elsewhere
     check_table(table, expected)
     assert len({r["variant"] for r in table}) == 8
     deadline = time.time() + 10  # the killed worker's odemag went with it (PR_SET_PDEATHSIG)
