@@ -222,6 +222,11 @@ TEST_F(Sweep, TableEqualsTheVariantsRunOneByOneAndResumesWithoutRerunning) {
   ASSERT_EQ(sweep(spec_file).status, 0);
   const auto longer = csv(read_file(dir_ / "out" / "results.csv"));
   for (size_t i = 1; i < longer.size(); ++i) EXPECT_EQ(longer[i][4], "50");  // 0.2 s of 4 ms steps
+  // A sweep that stops on a bad spec leaves the table it had, byte for byte.
+  const std::string kept = read_file(dir_ / "out" / "results.csv");
+  write("spec.json", std::string(changed).replace(changed.find("susceptibility"), 14, "susceptibilty"));
+  ASSERT_EQ(sweep(spec_file).status, 2);
+  EXPECT_EQ(read_file(dir_ / "out" / "results.csv"), kept);
   // No temporary files left beside the table.
   for (const fs::directory_entry& e : fs::directory_iterator(dir_ / "out"))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
