@@ -19,6 +19,8 @@ packages=(
   libgtest-dev libbenchmark-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-pyode  # the Python package and its tests (docs/python.md)
   gnuplot-nox
+  python3-distributed  # the sweep runners (python/odemag/sweeps.py) and their tests
+  slurm-wlm  # python/tests/test_slurm.py starts a single-node Slurm (skips where it cannot)
   "${sanitize_packages[@]}"
   "$@"
 )

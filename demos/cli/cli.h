@@ -4,6 +4,8 @@
 // other exception: exit 1).
 #pragma once
 
+#include <sys/types.h>
+
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -98,6 +100,16 @@ struct RunCommandLine {
   // encoded by the ffmpeg program after the run; needs the frames.
   std::optional<std::string> video;
 };
+struct SweepCommandLine {
+  enum class Mode { local, expand, variant, gather, dask, slurm };
+  std::string spec, out;
+  Mode mode = Mode::local;
+  size_t variant = 0;  // --variant I
+  int jobs = 1;        // --jobs N (default: one per core)
+  std::string dask;    // --dask local[:N] | ADDRESS
+  bool quiet = false;
+};
+SweepCommandLine parse_sweep_command(std::vector<std::string> args);
 SolveCommandLine parse_solve_command(const std::vector<std::string>& args);
 FieldCommandLine parse_field_command(const std::vector<std::string>& args);
 RunCommandLine parse_run_command(const std::vector<std::string>& args);
@@ -124,6 +136,21 @@ int run_field(const std::vector<std::string>& args);
 using FrameWriterFactory =
     std::function<std::unique_ptr<FrameWriter>(const SceneDescription& scene)>;
 int run_simulation(const std::vector<std::string>& args, const FrameWriterFactory& frames);
+
+// `odemag sweep SPEC --out DIR ...` (docs/sweeps.md): runs the variants of a
+// sweep spec (engine/scene/sweep.h) and writes DIR/results.csv; also the
+// steps the Dask and Slurm runners call (--expand, --variant I, --gather).
+int run_sweep(const std::vector<std::string>& args, const FrameWriterFactory& frames);
+
+// The numbers of a run's summary.json that a sweep can collect, as key paths
+// ("steps", "magnetic_ms.mean"); run.cpp writes them.
+const std::vector<std::string>& summary_figures();
+
+// Starts the program (argv `args`, without a shell; stdout to /dev/null when
+// quiet_stdout) and returns its pid; wait_program returns its exit status (a
+// signal: 128 + the signal number). Throw std::runtime_error.
+pid_t start_program(const std::string& program, std::vector<std::string> args, bool quiet_stdout = false);
+int wait_program(pid_t pid);
 
 // The text with control characters (newlines included) replaced by spaces:
 // messages on stderr are one line each.

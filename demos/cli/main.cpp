@@ -38,13 +38,20 @@ int dispatch(const std::string& command, const std::vector<std::string>& args) {
     return odemag::cli::run_simulation(args, odemag::cli::FrameWriterFactory{});
 #endif
   }
-  throw odemag::cli::UsageError("unknown command '" + command + "' (commands: solve, field, run, help)");
+  if (command == "sweep") {
+#ifdef ODEMAG_WITH_RENDERER
+    return odemag::cli::run_sweep(args, odemag::make_png_frame_writer);
+#else
+    return odemag::cli::run_sweep(args, odemag::cli::FrameWriterFactory{});
+#endif
+  }
+  throw odemag::cli::UsageError("unknown command '" + command + "' (commands: solve, field, run, sweep, help)");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) return usage_error("missing command; usage: odemag solve|field|run|help ... (see odemag --help)");
+  if (argc < 2) return usage_error("missing command; usage: odemag solve|field|run|sweep|help ... (see odemag --help)");
   const std::string command = argv[1];
   const std::vector<std::string> args(argv + 2, argv + argc);
   try {

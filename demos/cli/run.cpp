@@ -213,19 +213,8 @@ std::string check_video(const RunCommandLine& c, bool renderer) {
   return ffmpeg;
 }
 
-// Runs the program with argv `args`, without a shell; its exit status (a
-// signal: 128 + the signal number).
-int run_program(const std::string& program, std::vector<std::string> args) {
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (const int err = posix_spawn(&pid, program.c_str(), nullptr, nullptr, argv.data(), environ); err != 0)
-    throw std::runtime_error("cannot run " + program + ": " + std::strerror(err));
-  int raw = 0;
-  while (waitpid(pid, &raw, 0) < 0)
-    if (errno != EINTR) throw std::runtime_error("waiting for " + program + ": " + std::strerror(errno));
-  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+int run_program(const std::string& program, const std::vector<std::string>& args) {
+  return wait_program(start_program(program, args));
 }
 
 // Encodes DIR/frame_NNNNN.png at `rate` frames per second: MP4 as H.264
@@ -264,6 +253,38 @@ void encode_video(const std::string& ffmpeg, const std::filesystem::path& dir, c
 }
 
 }  // namespace
+
+pid_t start_program(const std::string& program, std::vector<std::string> args, bool quiet_stdout) {
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  if (quiet_stdout) posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int err = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (err != 0) throw std::runtime_error("cannot run " + program + ": " + std::strerror(err));
+  return pid;
+}
+
+int wait_program(pid_t pid) {
+  int raw = 0;
+  while (waitpid(pid, &raw, 0) < 0)
+    if (errno != EINTR) throw std::runtime_error("waiting for process " + std::to_string(pid) + ": " + std::strerror(errno));
+  return WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+}
+
+const std::vector<std::string>& summary_figures() {
+  static const std::vector<std::string> figures = [] {
+    std::vector<std::string> f = {"bodies", "cells", "responsive_cells", "time_step", "duration", "steps",
+                                  "frames", "wall_seconds", "steps_not_converged", "magnetic_steps_skipped"};
+    for (const char* group : {"magnetic_ms", "rigid_ms", "iterations", "substeps"})
+      for (const char* s : {"median", "p90", "mean", "max", "total"}) f.push_back(std::string(group) + "." + s);
+    return f;
+  }();
+  return figures;
+}
 
 int run_simulation(const std::vector<std::string>& args, const FrameWriterFactory& frames) {
   const RunCommandLine c = parse_run_command(args);
@@ -324,7 +345,8 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   progress.update(sim, true);
   if (c.video) encode_video(ffmpeg, dir, *c.video, settings.frame_rate);  // before summary.json: a finished run
 
-  // summary.json: the cost of every rigid step and the scene's outcomes.
+  // summary.json: the cost of every rigid step and the scene's outcomes
+  // (summary_figures() lists its numbers for sweeps: keep the two together).
   std::vector<double> tm, tr, iterations, substeps;
   long not_converged = 0, skipped = 0;
   for (const StepRecord& r : sim.records()) {

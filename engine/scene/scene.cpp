@@ -1477,7 +1477,7 @@ std::vector<SceneKeyDoc> scene_key_docs() {
   return docs;
 }
 
-SceneDescription parse_scene(const std::string& json_text, const std::string& file) {
+void check_json_text(const std::string& json_text, const std::string& file) {
   // The JSON parser takes a NUL byte for the end of the text: whatever follows
   // it would be ignored.
   if (const size_t nul = json_text.find('\0'); nul != std::string::npos)
@@ -1491,6 +1491,10 @@ SceneDescription parse_scene(const std::string& json_text, const std::string& fi
     // The key being read when the text broke off: "FILE: bodies[1].position: invalid JSON: ...".
     throw SceneError(file, tracker.path(), "invalid JSON: " + what);
   }
+}
+
+SceneDescription parse_scene(const std::string& json_text, const std::string& file) {
+  check_json_text(json_text, file);
   json root;
   try {
     root = json::parse(json_text);  // the text the first pass accepted
@@ -1501,7 +1505,7 @@ SceneDescription parse_scene(const std::string& json_text, const std::string& fi
   return read_scene(SceneReader(file), root);
 }
 
-SceneDescription load_scene(const std::string& path) {
+std::string read_json_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw SceneError(path, "", "cannot open: is a directory");
   std::ifstream in(path, std::ios::binary);
@@ -1516,7 +1520,9 @@ SceneDescription load_scene(const std::string& path) {
     if (text.size() > kMaxSceneBytes) throw SceneError(path, "", "the file is larger than 256 MiB");
   }
   if (in.bad()) throw SceneError(path, "", "cannot read the file");
-  return parse_scene(text, path);
+  return text;
 }
+
+SceneDescription load_scene(const std::string& path) { return parse_scene(read_json_file(path), path); }
 
 }  // namespace odemag

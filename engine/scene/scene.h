@@ -227,10 +227,18 @@ struct SceneKeyDoc {
 // reads them and lists them in "unknown key" messages.
 std::vector<SceneKeyDoc> scene_key_docs();
 
+// The text of a scene (or sweep spec) file, read in pieces up to 256 MiB.
+// Throws SceneError(path, "", ...) when it cannot be read.
+std::string read_json_file(const std::string& path);
 // Reads and validates a scene file. Throws SceneError (bad content, unknown
 // key, wrong type, NaN, negative size, missing key, unknown material, ...).
 SceneDescription load_scene(const std::string& path);
 // Same, from JSON text; `file` is used in messages.
 SceneDescription parse_scene(const std::string& json_text, const std::string& file);
+// The checks parse_scene makes on the text before it reads any key: valid,
+// finite JSON without NUL bytes, duplicate keys or nesting beyond 64 levels.
+// Throws SceneError naming `file` (and the key path where the text failed).
+// Sweep specs (engine/scene/sweep.h) are read through it too.
+void check_json_text(const std::string& json_text, const std::string& file);
 
 }  // namespace odemag

@@ -192,6 +192,7 @@ TEST(FuzzRegression, EveryCommandLineIsAcceptedOrAUsageError) {
       if (w[0] == "solve") cli::parse_solve_command(args);
       if (w[0] == "field") cli::parse_field_command(args);
       if (w[0] == "run") cli::parse_run_command(args);
+      if (w[0] == "sweep") cli::parse_sweep_command(args);
     } catch (const cli::UsageError& e) {
       EXPECT_FALSE(std::string(e.what()).empty());
     } catch (const std::exception& e) {

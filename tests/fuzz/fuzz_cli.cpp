@@ -39,6 +39,11 @@ void check_command_line(const std::vector<std::string>& words) {
     if (c.solve.threads && (*c.solve.threads < 0 || *c.solve.threads > 65536)) __builtin_trap();
     return;
   }
+  if (command == "sweep") {
+    const SweepCommandLine c = parse_sweep_command(args);
+    if (c.out.empty() || c.jobs < 1 || c.jobs > 1024) __builtin_trap();
+    return;
+  }
   throw UsageError("unknown command '" + command + "'");
 }
 
