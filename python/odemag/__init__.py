@@ -27,6 +27,6 @@ except ImportError as _missing:
         raise ImportError(f"odemag.{name} needs the built extension odemag._core "
                           f"(build/python, docs/python.md): {_MISSING_EXTENSION}")
 
-from .sweep import sweep  # noqa: E402  (odemag.sweep(spec, out, ...): the Dask runner)
+from .sweeps import sweep  # noqa: E402  (odemag.sweep(spec, out, ...): the Dask runner)
 
 __all__ = ["load", "Scene", "Solution", "Field", "Simulation", "Magnetics", "SceneError", "sweep"]
