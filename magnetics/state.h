@@ -52,6 +52,12 @@ struct MagneticState {
   // Inputs of the last converged magnetic step; invalidate (valid = false)
   // after editing moments or magnetizations by hand.
   SolvedInputs last_solve;
+
+  // The largest cell field scale |H_A| + gamma |M| (A/m) any converged
+  // relaxation of this state reached: a millionth of it floors the scale of
+  // the relaxation's residual, so that fields falling to zero converge
+  // (magnetics/relax.cpp, docs/model.md "Relaxation").
+  double peak_field_scale = 0.0;
 };
 
 // A state for the model: identity poses at the origin, all bodies active,

@@ -49,8 +49,12 @@
 // less than 1e-4 R in a lattice body's frame keeps its pairs, carried to its
 // new offset to first order (magnetics/ball_lattice_near_field.cpp; fields
 // off by ~1e-10, forces by ~1e-5 of the correction), and the pair's point
-// dipole terms share one coefficient evaluation. The same three scenes
-// moved; outcomes in docs/scenes.md "stop 26".
+// dipole terms share one coefficient evaluation (ball_chain, iron_plate and
+// thin_iron_plate moved); and the residual's field scale floored at 1e-6 of
+// the largest a converged relaxation of the state reached
+// (MagneticState::peak_field_scale: fields falling to zero ran to the
+// iteration cap), which moves convergence decisions of weak cells in every
+// scene. Outcomes in docs/scenes.md "stop 26".
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -111,10 +115,10 @@ struct Case {
 };
 
 const Case kCases[] = {
-    {"ball_chain", 1.5, 0xe7b1ee68b00be698ULL},
-    {"iron_plate", 1.7, 0x7350df074b8ef746ULL},
-    {"thin_iron_plate", 1.0, 0x12f726fde6abba64ULL},
-    {"nail_and_balls", 3.2, 0x9aa65ef8207e0153ULL},
+    {"ball_chain", 1.5, 0x777ed691b1b85390ULL},
+    {"iron_plate", 1.7, 0xdd35e3117cd08f77ULL},
+    {"thin_iron_plate", 1.0, 0x6c2b43df7a442f2bULL},
+    {"nail_and_balls", 3.2, 0xbab5752d069f5028ULL},
 };
 
 // Set by tests/engine/CMakeLists.txt for a Release build with
