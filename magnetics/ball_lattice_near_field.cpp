@@ -540,10 +540,10 @@ class BallLatticeNearField final : public NearFieldTerm {
     }
   }
 
-  double energy(const MagneticModel& model, const MagneticState& state) const override {
+  double energy(const MagneticModel& /*model*/, const MagneticState& state) const override {
     double e = 0.0;
     for_each_pair([&](const BallCellPair& p) {
-      e -= kMu0 * dot(moment(model, state, p.b), symmetric_times(p.K, moment(model, state, p.c)));
+      e -= kMu0 * dot(p.volume_b * state.magnetization[p.b], symmetric_times(p.K, p.volume_c * state.magnetization[p.c]));
     });
     return e;
   }
@@ -623,10 +623,6 @@ class BallLatticeNearField final : public NearFieldTerm {
       cached_.push_back(std::move(lb));
     }
     groups_.assign(static_cast<std::size_t>(model.body_count()) * cached_.size(), {});
-  }
-
-  static Vec3 moment(const MagneticModel& model, const MagneticState& state, int cell) {
-    return model.cell_volume(cell) * state.magnetization[cell];
   }
 
   // The solid a cell's field comes from: in a box body its part of the body,

@@ -31,20 +31,14 @@ int dispatch(const std::string& command, const std::vector<std::string>& args) {
   }
   if (command == "solve") return odemag::cli::run_solve(args);
   if (command == "field") return odemag::cli::run_field(args);
-  if (command == "run") {
+  // PNG frames where the program is built with the renderer.
 #ifdef ODEMAG_WITH_RENDERER
-    return odemag::cli::run_simulation(args, odemag::make_png_frame_writer);
+  const odemag::cli::FrameWriterFactory frames = odemag::make_png_frame_writer;
 #else
-    return odemag::cli::run_simulation(args, odemag::cli::FrameWriterFactory{});
+  const odemag::cli::FrameWriterFactory frames;
 #endif
-  }
-  if (command == "sweep") {
-#ifdef ODEMAG_WITH_RENDERER
-    return odemag::cli::run_sweep(args, odemag::make_png_frame_writer);
-#else
-    return odemag::cli::run_sweep(args, odemag::cli::FrameWriterFactory{});
-#endif
-  }
+  if (command == "run") return odemag::cli::run_simulation(args, frames);
+  if (command == "sweep") return odemag::cli::run_sweep(args, frames);
   throw odemag::cli::UsageError("unknown command '" + command + "' (commands: solve, field, run, sweep, help)");
 }
 
