@@ -7,14 +7,15 @@
 //       runs the scene to time T and writes the rigid bodies' states and the
 //       magnetic moments to FILE (binary, not portable; a scratch file).
 //   crane_window --scene PATH --snapshot FILE --steps N [--magnetization-scale S]
-//       [--threads N] [--label TEXT] [--old]
+//       [--threads N] [--label TEXT] [--old] [--no-precondition]
 //       rebuilds the scene without its time line (the crane held where its
 //       track ends, at magnetization scale S, default 0: coil off), puts the
 //       saved states back, and steps N times. Under valgrind --tool=callgrind
 //       --instr-atstart=no only these steps are counted. Prints the window's
 //       T_m, T_r, outer iterations, substeps, balls above 0.1 m, and an
 //       FNV-1a hash of the final positions. --old: the relaxation as before
-//       issue 14 (use_solver_before_issue_14).
+//       issue 14 (use_solver_before_issue_14); --no-precondition: without the
+//       outer loop's block preconditioner (RelaxOptions::precondition_bodies).
 //   crane_window --scene PATH --steps N [--duration-start 0]
 //       without --snapshot: the first N steps of the scene as it is.
 #include <valgrind/callgrind.h>
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
               label = "window";
   double save_at = -1.0, scale = 0.0;
   int steps = 100, threads = 2;
-  bool old_solver = false, histories = false;
+  bool old_solver = false, histories = false, plain = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--scene") scene_path = bench::option_value(argc, argv, i, "crane_window");
@@ -83,6 +84,7 @@ int main(int argc, char** argv) {
     else if (a == "--label") label = bench::option_value(argc, argv, i, "crane_window");
     else if (a == "--old") old_solver = true;
     else if (a == "--histories") histories = true;
+    else if (a == "--no-precondition") plain = true;
     else {
       std::fprintf(stderr, "crane_window: unknown argument '%s'\n", a.c_str());
       return 2;
@@ -91,6 +93,7 @@ int main(int argc, char** argv) {
   SceneDescription scene = load_scene(scene_path);
   scene.solver.threads = threads;
   if (old_solver) use_solver_before_issue_14(scene.solver.relax);
+  if (plain || old_solver) scene.solver.relax.precondition_bodies = false;
   const bool saving = save_at >= 0.0, replaying = !saving && !snapshot.empty();
   if (saving) {
     Simulation sim(scene);

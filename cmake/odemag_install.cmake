@@ -44,7 +44,7 @@ set(ODEMAG_PUBLIC_HEADERS
   engine/sim/magnetic_system.h engine/sim/outcomes.h engine/sim/solve.h  # simulation
   gpu/cuda_backend.h
   magnetics/backend.h magnetics/cells.h magnetics/constants.h magnetics/demag_tensor.h
-  magnetics/bh_curve.h magnetics/coil.h magnetics/hd.h magnetics/llg.h magnetics/material.h magnetics/model.h magnetics/relax.h
+  magnetics/bh_curve.h magnetics/body_response.h magnetics/coil.h magnetics/hd.h magnetics/llg.h magnetics/material.h magnetics/model.h magnetics/relax.h
   magnetics/rng.h magnetics/shape.h magnetics/small_eigen.h magnetics/state.h magnetics/vec3.h)
 foreach(header IN LISTS ODEMAG_PUBLIC_HEADERS)
   get_filename_component(dir ${header} DIRECTORY)

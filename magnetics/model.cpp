@@ -229,6 +229,7 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     // Diamagnets (recoil < 0) take none: its update needs N + 1/chi positive definite.
     if (!body.cells.whole_cells && intra_tensor_ == IntraBodyTensor::cell_average && body.recoil >= 0.0)
       build_boundary_correction(body);
+    body.response = build_body_response(body);
   }
 
   for (int c = 0; c < body.cell_count(); ++c) {

@@ -5,10 +5,12 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "magnetics/bh_curve.h"
+#include "magnetics/body_response.h"
 #include "magnetics/cells.h"
 #include "magnetics/coil.h"
 #include "magnetics/demag_tensor.h"
@@ -64,6 +66,9 @@ struct MagneticBody {
   std::vector<double> self_tensors;
   std::vector<double> uniform_tensors;
   Mat3 uniform_inverse[2];
+  // The factor of the body's linear self-response (magnetics/body_response.h),
+  // the outer loop's block preconditioner; null for bodies that take none.
+  std::shared_ptr<const BodyResponseFactor> response;
 
   int cell_count() const { return cells.size(); }
   bool inert() const { return cells.size() == 0; }

@@ -54,6 +54,11 @@ struct RelaxOptions {
   // field"): induced higher multipoles of one-cell spheres, cell-averaged
   // coupling of aligned lattice cells. false: point dipoles only (the paper).
   bool near_field = true;
+  // Block preconditioner of the outer loop: high-chi isotropic lattice bodies
+  // below saturation get a Newton step for their own linear response
+  // (magnetics/body_response.h, docs/model.md "Block preconditioner").
+  // false: Anderson on the plain residual, as before.
+  bool precondition_bodies = true;
   LocalRelaxOptions local;
   // Called after every outer iteration with the report so far (iterations,
   // residual_history): progress lines of a long `odemag solve`. Empty: none.

@@ -55,6 +55,12 @@
 // (MagneticState::peak_field_scale: fields falling to zero ran to the
 // iteration cap), which moves convergence decisions of weak cells in every
 // scene. Outcomes in docs/scenes.md "stop 26".
+// Re-pinned (stop 27) for the outer loop's block preconditioner
+// (magnetics/body_response.h): the iron plates (chi = 5000, 105 and 156
+// cells) converge in fewer iterations to the same fixed point within the
+// tolerance, so their numbers round differently; iron_plate and
+// thin_iron_plate moved, ball_chain and nail_and_balls (no body takes it)
+// kept their hashes. Outcomes in docs/scenes.md "stop 27".
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -116,8 +122,8 @@ struct Case {
 
 const Case kCases[] = {
     {"ball_chain", 1.5, 0x777ed691b1b85390ULL},
-    {"iron_plate", 1.7, 0xdd35e3117cd08f77ULL},
-    {"thin_iron_plate", 1.0, 0x6c2b43df7a442f2bULL},
+    {"iron_plate", 1.7, 0xc095830c7cd17eccULL},
+    {"thin_iron_plate", 1.0, 0xb1b2f30780423639ULL},
     {"nail_and_balls", 3.2, 0xbab5752d069f5028ULL},
 };
 

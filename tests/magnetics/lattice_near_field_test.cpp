@@ -138,8 +138,9 @@ CutCubeResult relax_cut_cube(int px, int py, int pz, bool near_field, bool magne
 
 // Measured (chi = 1000, 8 x 8 x 8 cells; uncut 41 iterations): moment error
 // 4.7e-5 / 4.4e-5 / 4.2e-5 for 2 / 4 / 8 pieces with the correction (41-42
-// iterations); without it 3.2e-2 (348 iterations) / 2.9e-2 / 2.4e-2 (not
-// converged in 400). The rest is the cutoff (point dipoles beyond 3 h).
+// iterations before the block preconditioner); without it 3.2e-2 (348
+// iterations) / 2.9e-2 / 2.4e-2 (not converged in 400). The rest is the
+// cutoff (point dipoles beyond 3 h).
 TEST(LatticeNearField, CutCubeKeepsItsMoment) {
   const CutCubeResult whole = relax_cut_cube(1, 1, 1, true, false);
   ASSERT_TRUE(whole.report.converged);
@@ -152,11 +153,12 @@ TEST(LatticeNearField, CutCubeKeepsItsMoment) {
     EXPECT_LT(e_with, 5e-3);
   }
   // Without the correction (the point dipoles of the paper) the halves differ
-  // by percents and do not converge in the default 200 iterations.
+  // by percents. (They did not converge in the default 200 iterations before
+  // the block preconditioner, magnetics/body_response.h; they converge now, to
+  // the wrong moment: measured 3.2e-2.)
   const CutCubeResult without = relax_cut_cube(2, 1, 1, false, false);
   std::printf("[lattice near field] cube cut 2x1x1 without the correction: moment error %.2e, converged %d\n",
               rel(without.moment, whole.moment), without.report.converged ? 1 : 0);
-  EXPECT_FALSE(without.report.converged);
   EXPECT_GT(rel(without.moment, whole.moment), 1e-2);
 }
 
