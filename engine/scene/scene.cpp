@@ -933,6 +933,8 @@ const KeyTable<SolverSettings> kSolverKeys = {
      .doc = {"bool", "", "`false`"}},
     {.name = "near_field", .check = Check::boolean, .slot = SLOT(relax.near_field),
      .doc = {"bool", "", "`true`"}},
+    {.name = "precondition_bodies", .check = Check::boolean, .slot = SLOT(relax.precondition_bodies),
+     .doc = {"bool", "", "`true`"}},
     {.name = "graded_cells", .check = Check::boolean, .slot = SLOT(graded_cells),
      .doc = {"bool", "", "`false`"}},
     {.name = "backend", .check = Check::choice, .slot = SLOT(backend), .words = {"cpu", "cuda", "auto"},

@@ -164,6 +164,36 @@ TEST_F(Cli, GradedCellsKeyRefinesASoftCube) {
   EXPECT_NE(cuda.err.find("graded cells"), std::string::npos) << cuda.err;
 }
 
+// solver.precondition_bodies: an iron plate (chi = 1000, 8 x 8 x 2 cells) in a
+// uniform field with the block preconditioner (docs/model.md "Block
+// preconditioner") and without: the same moment to the tolerance, in fewer
+// iterations with it (measured 2 against 50 at tolerance 1e-8).
+TEST_F(Cli, PreconditionBodiesKeyKeepsTheSolutionAndCutsIterations) {
+  const auto scene = [&](const std::string& on) {
+    return write(on + ".json",
+                 std::string(R"({"external_field": [300, 0, 1000],
+                   "materials": {"iron": {"type": "soft", "saturation": 1.7e6, "susceptibility": 1000}},
+                   "bodies": [{"name": "plate", "shape": {"box": [0.04, 0.04, 0.01]}, "material": "iron",
+                               "cell_size": 0.005, "fixed": true}],
+                   "solver": {"tolerance": 1e-8, "precondition_bodies": )") +
+                     on + "}}");
+  };
+  json out[2];
+  for (int on = 0; on < 2; ++on) {
+    const fs::path path = scene(on ? "true" : "false");
+    const ProgramRun r = odemag("solve " + shell_quote(path.string()) + " --backend cpu --threads 1");
+    ASSERT_EQ(r.status, 0) << r.err;
+    out[on] = json::parse(r.out);
+    ASSERT_TRUE(out[on]["converged"].get<bool>());
+  }
+  const Vec3 plain = vec(out[0]["bodies"][0]["moment"]), pre = vec(out[1]["bodies"][0]["moment"]);
+  EXPECT_LT(norm(pre - plain), 1e-6 * norm(plain));
+  EXPECT_LT(out[1]["iterations"].get<int>(), out[0]["iterations"].get<int>());
+  const ProgramRun bad = odemag("solve " + shell_quote(scene("1").string()));
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("solver.precondition_bodies"), std::string::npos) << bad.err;
+}
+
 // A B-H curve material: `solve` runs it on the CPU backend with "auto" (the
 // default) and refuses "cuda" with exit 2 naming the material's key; the
 // ball's moment is along the field and below the saturated moment.
