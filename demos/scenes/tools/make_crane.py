@@ -3,7 +3,14 @@
 into a heap of steel balls in a bin, lifts a heap of induced magnets, then its
 magnetization is lowered and switched off. Balls have random easy axes (random
 orientations), so a few keep enough remanence to hang on when it is off.
-Usage: make_crane.py [--balls N] [--out PATH] [--seed S] [--coil H] [--ms M] [--hk H] [--moments N]"""
+With --electromagnet the crane is a real electromagnet instead of the paper's
+model (a uniform coil field inside the core only, a linear-to-saturation core):
+a copper winding (`coils`: a rounded-rectangle coil around the core) whose
+field also acts outside the core, and a core of low-carbon steel with the
+TEAM problem 20 B-H curve (demos/scenes/crane_electromagnet.json,
+crane_electromagnet_small.json; docs/scenes.md).
+Usage: make_crane.py [--balls N] [--out PATH] [--seed S] [--coil H] [--ms M] [--hk H] [--moments N]
+                     [--electromagnet] [--ampere-turns NI]"""
 import argparse, json, math, random
 
 p = argparse.ArgumentParser()
@@ -19,6 +26,8 @@ p.add_argument("--coil", type=float, default=5e5)     # coil field in the core, 
 p.add_argument("--ms", type=float, default=8e5)       # saturation of the balls, A/m
 p.add_argument("--hk", type=float, default=3.2e5)     # anisotropy field of the balls, A/m
 p.add_argument("--moments", type=int, default=8)      # moments per ball cell
+p.add_argument("--electromagnet", action="store_true")  # a real coil and a steel B-H curve
+p.add_argument("--ampere-turns", type=float, default=30000)  # the winding's N I at full current, A
 args = p.parse_args()
 rng = random.Random(args.seed)
 
@@ -26,6 +35,22 @@ R = 0.005                  # ball radius, m
 bin_half = 0.065           # inner half width of the bin, m
 crane = [0.12, 0.12, 0.03]  # crane magnet (box), m
 h_crane = 0.012            # its lattice spacing: 10 x 10 x 2 = 200 cells
+# --electromagnet: the winding around the core, a rounded-rectangle coil from
+# 2 mm to 42 mm off the core's sides (40 mm radial build), 60 mm tall, its
+# lower end flush with the core's pole face (it stands 30 mm above the core's
+# back, away from the load). Section 40 x 60 mm = 2.4e-3 m^2, so 30 kAT is a
+# mean current density of 12.5 A/mm^2 over the section (docs/scenes.md: why).
+coil_gap, coil_build, coil_height = 0.002, 0.04, 0.06
+coil_turns = 500
+# Low-carbon steel, the B-H table of the Compumag TEAM workshop's problem 20
+# statement ("3-D static force problem", its Table 1; N. Takahashi, T. Nakata,
+# H. Morishige, IEEE Trans. Magn. 30(5), 3483, 1994), as (H, B) in A/m and T: Ms = B/mu0 - H at the last point = 1.695e6 A/m, initial mu_r 295.
+TEAM20_BH = [(0, 0.0), (27, 0.01), (58, 0.025), (100, 0.05), (153, 0.1), (185, 0.15), (205, 0.2),
+             (233, 0.3), (255, 0.4), (285, 0.5), (320, 0.6), (355, 0.7), (405, 0.8), (470, 0.9),
+             (555, 1.0), (673, 1.1), (836, 1.2), (1065, 1.3), (1220, 1.35), (1420, 1.4), (1720, 1.45),
+             (2130, 1.5), (2670, 1.55), (3480, 1.6), (4500, 1.65), (5950, 1.7), (7650, 1.75),
+             (10100, 1.8), (13000, 1.85), (15900, 1.9), (21100, 1.95), (26300, 2.0), (32900, 2.05),
+             (42700, 2.1), (61700, 2.15), (84300, 2.2), (110000, 2.25), (135000, 2.3)]
 
 def random_quaternion():
     u1, u2, u3 = rng.random(), rng.random(), rng.random()
@@ -50,9 +75,26 @@ while len(balls) < args.balls:
     layer += 1
 top = max(b[2] for b in balls) + R
 wall_h = 0.05
+crane_body = {"name": "crane", "shape": {"box": crane}, "material": "crane_core", "position": [0, 0, 0.2],
+              "fixed": True, "cell_size": h_crane}
+core_material = {"type": "soft", "saturation": 1.7e6, "susceptibility": 1000,
+                 "coil_field": [0, 0, -args.coil], "color": [0.35, 0.35, 0.4]}
+title = ("Crane magnet (paper Fig. 17): an electromagnet lifts a heap of steel balls; its "
+         "magnetization is lowered, then switched off, and a few balls hang on by remanence")
+if args.electromagnet:
+    # Field along -z (down into the heap) like the paper's coil_field:
+    # positive current about axis -z.
+    crane_body["coils"] = [{"type": "rounded_rectangle", "core_half_width": crane[0] / 2,
+                            "core_half_depth": crane[1] / 2, "inner_corner_radius": coil_gap,
+                            "outer_corner_radius": coil_gap + coil_build, "height": coil_height,
+                            "centre": [0, 0, coil_height / 2 - crane[2] / 2], "axis": [0, 0, -1],
+                            "current": args.ampere_turns / coil_turns, "turns": coil_turns}]
+    core_material = {"type": "soft", "bh_curve": [[h, b] for h, b in TEAM20_BH], "color": [0.35, 0.35, 0.4]}
+    title = (f"Crane electromagnet: a {args.ampere_turns / 1000:g} kAT copper coil on a low-carbon steel "
+             "core (TEAM 20 B-H curve) lifts a heap of steel balls; its current is lowered, then "
+             "switched off, and a few balls hang on by remanence")
 bodies = [
-    {"name": "crane", "shape": {"box": crane}, "material": "crane_core", "position": [0, 0, 0.2],
-     "fixed": True, "cell_size": h_crane},
+    crane_body,
     {"name": "bin_left", "shape": {"box": [0.01, 2 * bin_half + 0.02, wall_h]}, "material": "steel_plate_inert",
      "position": [-bin_half - 0.005, 0, wall_h / 2], "fixed": True},
     {"name": "bin_right", "shape": {"box": [0.01, 2 * bin_half + 0.02, wall_h]}, "material": "steel_plate_inert",
@@ -71,12 +113,10 @@ up = 0.2
 keys = [{"time": 0.0, "position": [0, 0, up]}, {"time": 0.8, "position": [0, 0, low]},
         {"time": 1.3, "position": [0, 0, low]}, {"time": 2.3, "position": [0, 0, up]}]
 scene = {
-    "title": "Crane magnet (paper Fig. 17): an electromagnet lifts a heap of steel balls; its "
-             "magnetization is lowered, then switched off, and a few balls hang on by remanence",
+    "title": title,
     "gravity": [0, 0, -9.81], "cell_size": 0.0, "seed": 17,
     "materials": {
-        "crane_core": {"type": "soft", "saturation": 1.7e6, "susceptibility": 1000,
-                       "coil_field": [0, 0, -args.coil], "color": [0.35, 0.35, 0.4]},
+        "crane_core": core_material,
         "steel": {"type": "soft", "saturation": args.ms, "susceptibility": 1000, "anisotropy_field": args.hk,
                   "easy_axis": [0, 0, 1], "moments_per_cell": args.moments, "color": [0.72, 0.74, 0.78]},
         "steel_plate_inert": {"type": "inert", "color": [0.5, 0.42, 0.3]},
