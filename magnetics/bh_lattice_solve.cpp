@@ -90,69 +90,85 @@ BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, 
                                const BhSolveOptions& options) {
   const int N = demag.cells();
   M.resize(N);
-  std::vector<Vec3> H(N), G(N), trial(N), Hd;
+  std::vector<Vec3> H(N), R(N), trial(N), Hd, m(N);
   std::vector<std::array<double, 6>> J(N);
   std::vector<Eigen::Matrix3d> block(N);
-  // G(M) of (3) and |G| / |w f(H)|; fills H, and J when asked.
-  auto residual = [&](const std::vector<Vec3>& m, std::vector<Vec3>& g, bool jacobian) {
+  double source = 0.0;
+  for (const Vec3& h : H_source) source += squared_norm(h);
+  source = std::sqrt(source);
+  // R(H) = H - H_source - H_d(w f(H)) of (4), |R| / |H_source|; sets m = w f(H), J,
+  // and g = |G| / |w f(H)|, the residual of (3) at M = m.
+  double g = 0.0;
+  auto residual = [&](const std::vector<Vec3>& h, std::vector<Vec3>& r) {
+    for (int i = 0; i < N; ++i) m[i] = bh_cell_law(curve, fill[i], h[i], J[i].data());
     demag.field(m, Hd);
-    double gg = 0.0, ff = 0.0;
+    double rr = 0.0, gg = 0.0, mm = 0.0;
     for (int i = 0; i < N; ++i) {
-      H[i] = H_source[i] + Hd[i];
-      double jac[6];
-      const Vec3 f = bh_cell_law(curve, fill[i], H[i], jac);
-      if (jacobian) std::copy(jac, jac + 6, J[i].begin());
-      g[i] = m[i] - f;
-      gg += squared_norm(g[i]);
-      ff += squared_norm(f);
+      r[i] = h[i] - H_source[i] - Hd[i];
+      rr += squared_norm(r[i]);
+      double unused[6];
+      gg += squared_norm(m[i] - bh_cell_law(curve, fill[i], h[i] - r[i], unused));
+      mm += squared_norm(m[i]);
     }
-    return ff > 0.0 ? std::sqrt(gg / ff) : std::sqrt(gg);
+    g = mm > 0.0 ? std::sqrt(gg / mm) : std::sqrt(gg);
+    return source > 0.0 ? std::sqrt(rr) / source : std::sqrt(rr);
   };
   BhSolveReport report;
-  double r = residual(M, G, true);
-  report.residuals.push_back(r);
+  // The initial field: from the initial M; for M = 0, H = 0, so that the
+  // first Newton step is the linear solve with the initial susceptibility.
+  bool zero = true;
+  for (const Vec3& v : M) zero = zero && squared_norm(v) == 0.0;
+  if (!zero) {
+    demag.field(M, Hd);
+    for (int i = 0; i < N; ++i) H[i] = H_source[i] + Hd[i];
+  }
+  double r = residual(H, R);
+  report.residuals.push_back(g);
   const auto& n0 = demag.self_tensor();
   std::vector<Vec3> x3(N), y3(N);
-  auto apply = [&](const VectorXd& x, VectorXd& y) {  // (I + J N) x, N x = -H_d(x)
-    std::copy(x.data(), x.data() + 3 * N, &x3[0].x);
+  auto apply = [&](const VectorXd& x, VectorXd& y) {  // (I + N J) x, N v = -H_d(v)
+    for (int i = 0; i < N; ++i) x3[i] = symmetric_times(J[i].data(), Vec3{x(3 * i), x(3 * i + 1), x(3 * i + 2)});
     demag.field(x3, y3);
-    y.resize(3 * N);
-    for (int i = 0; i < N; ++i) {
-      const Vec3 v = Vec3{x(3 * i), x(3 * i + 1), x(3 * i + 2)} - symmetric_times(J[i].data(), y3[i]);
-      y(3 * i) = v.x;
-      y(3 * i + 1) = v.y;
-      y(3 * i + 2) = v.z;
-    }
+    y = x;
+    for (int i = 0; i < N; ++i) y.segment<3>(3 * i) -= Eigen::Vector3d(y3[i].x, y3[i].y, y3[i].z);
   };
   auto precondition = [&](const VectorXd& x, VectorXd& y) {
     y.resize(3 * N);
     for (int i = 0; i < N; ++i) y.segment<3>(3 * i) = block[i] * x.segment<3>(3 * i);
   };
-  while (r > options.tolerance && report.newton_iterations < options.max_newton) {
-    for (int i = 0; i < N; ++i) {  // (I + J_i N(0))^-1
-      Eigen::Matrix3d Ji, Ni;
+  double eta = options.forcing;
+  while (g > options.tolerance && report.newton_iterations < options.max_newton) {
+    Eigen::Matrix3d Ni;
+    Ni << n0[0], n0[1], n0[2], n0[1], n0[3], n0[4], n0[2], n0[4], n0[5];
+    for (int i = 0; i < N; ++i) {  // (I + N(0) J_i)^-1
+      Eigen::Matrix3d Ji;
       const auto& j = J[i];
       Ji << j[0], j[1], j[2], j[1], j[3], j[4], j[2], j[4], j[5];
-      Ni << n0[0], n0[1], n0[2], n0[1], n0[3], n0[4], n0[2], n0[4], n0[5];
-      block[i] = (Eigen::Matrix3d::Identity() + Ji * Ni).inverse();
+      block[i] = (Eigen::Matrix3d::Identity() + Ni * Ji).inverse();
     }
-    VectorXd dM;
-    const VectorXd b = -flat(G);
-    report.krylov_iterations += gmres(apply, precondition, b, dM, options.forcing, options.restart, options.max_krylov);
-    // Backtracking on |G|: full step first, halved until |G| decreases.
+    VectorXd dH;
+    const VectorXd b = -flat(R);
+    report.krylov_iterations += gmres(apply, precondition, b, dH, eta, options.restart, options.max_krylov);
+    // Backtracking on |R|: full step first, halved until |R| decreases.
     double step = 1.0, r_trial = 0.0;
     for (int halvings = 0;; ++halvings, step *= 0.5) {
-      for (int i = 0; i < N; ++i) trial[i] = M[i] + step * Vec3{dM(3 * i), dM(3 * i + 1), dM(3 * i + 2)};
-      r_trial = residual(trial, G, true);
+      for (int i = 0; i < N; ++i) trial[i] = H[i] + step * Vec3{dH(3 * i), dH(3 * i + 1), dH(3 * i + 2)};
+      r_trial = residual(trial, R);
       if (r_trial < (1.0 - 1e-4 * step) * r || halvings == 10) break;
     }
-    M.swap(trial);
+    H.swap(trial);
+    // Eisenstat-Walker forcing (choice 2): loose while |R| falls slowly, tight near the solution.
+    const double previous = eta;
+    eta = std::min(options.forcing, 0.9 * (r_trial / r) * (r_trial / r));
+    if (0.9 * previous * previous > 0.1) eta = std::max(eta, 0.9 * previous * previous);
+    eta = std::max(eta, options.min_forcing);
     r = r_trial;
     ++report.newton_iterations;
-    report.residuals.push_back(r);
+    report.residuals.push_back(g);
   }
-  report.residual = r;
-  report.converged = r <= options.tolerance;
+  M = m;
+  report.residual = g;
+  report.converged = g <= options.tolerance;
   return report;
 }
 

@@ -26,7 +26,10 @@ namespace odemag {
 struct BhSolveOptions {
   double tolerance = 1e-7;   // on |G| / |w f(H)| (2-norms over all cells)
   int max_newton = 60;
-  double forcing = 1e-3;     // GMRES stops at this relative residual of the Newton system
+  // GMRES stops at the relative residual eta of the Newton system, eta by
+  // Eisenstat and Walker's choice 2 between min_forcing and forcing.
+  double forcing = 0.1;
+  double min_forcing = 1e-6;
   int restart = 80;
   int max_krylov = 3000;     // per Newton step
 };

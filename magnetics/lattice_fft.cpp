@@ -42,6 +42,16 @@ int triple(int i, int j, int k) {
   return -1;
 }
 
+// a0 b0 + a1 b1 + a2 b2 in plain real arithmetic (std::complex's operator*
+// checks for infinities through a library call).
+Complex multiply_add3(const Complex& a0, const Complex& b0, const Complex& a1, const Complex& b1, const Complex& a2,
+                      const Complex& b2) {
+  return {a0.real() * b0.real() - a0.imag() * b0.imag() + a1.real() * b1.real() - a1.imag() * b1.imag() +
+              a2.real() * b2.real() - a2.imag() * b2.imag(),
+          a0.real() * b0.imag() + a0.imag() * b0.real() + a1.real() * b1.imag() + a1.imag() * b1.real() +
+              a2.real() * b2.imag() + a2.imag() * b2.real()};
+}
+
 // The pair tensor at real offset d (target centre - source centre): N (six
 // components) and, when g is not null, its gradient g[k][c] = dN_c / dd_k (cubes only).
 void pair_tensor(const Vec3& cell, const Vec3& d, double n[6], double (*g)[6]) {
@@ -108,10 +118,12 @@ LatticeDemag::LatticeDemag(const Vec3& cell, std::vector<LatticeGrid> lattices,
     }
   };
   const std::array<int, 3> full = pad_;
+  // Pairs t <= s only: the kernel of (s, t) is that of (t, s) at -d (N(-d) =
+  // N(d)), whose spectrum is the complex conjugate.
   kernel_.resize(static_cast<size_t>(L) * L);
   std::vector<std::vector<double>> grids;
   for (int t = 0; t < L; ++t)
-    for (int s = 0; s < L; ++s) {
+    for (int s = t; s < L; ++s) {
       fill(t, s, false, 6, grids);
       for (int c = 0; c < 6; ++c) forward(grids[c], full, kernel_[t * L + s][c]);
     }
@@ -140,7 +152,7 @@ Vec3 LatticeDemag::centre(int cell) const {
 void LatticeDemag::forward(const std::vector<double>& in, const std::array<int, 3>& used, Spectrum& out) const {
   const int px = pad_[0], py = pad_[1], pz = pad_[2], hx = half_x_;
   out.assign(static_cast<size_t>(hx) * py * pz, Complex(0.0, 0.0));
-#pragma omp parallel
+#pragma omp parallel if (parallel())
   {
     Eigen::FFT<double> fft;
     fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
@@ -172,7 +184,7 @@ void LatticeDemag::forward(const std::vector<double>& in, const std::array<int, 
 void LatticeDemag::inverse(Spectrum& in, const std::array<int, 3>& used, std::vector<double>& out) const {
   const int px = pad_[0], py = pad_[1], pz = pad_[2], hx = half_x_;
   out.assign(static_cast<size_t>(px) * py * pz, 0.0);
-#pragma omp parallel
+#pragma omp parallel if (parallel())
   {
     Eigen::FFT<double> fft;
     fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
@@ -224,24 +236,32 @@ void LatticeDemag::field(const std::vector<Vec3>& M, std::vector<Vec3>& H) const
   source_spectra(M, m);
   H.assign(cells(), Vec3{});
   const size_t S = static_cast<size_t>(half_x_) * pad_[1] * pad_[2];
-  Spectrum h;
   std::vector<double> grid;
-  for (int t = 0; t < L; ++t)
-    for (int k = 0; k < 3; ++k) {
-      // (1): H_k = -sum_s sum_b N_kb^(ts) * M_b^(s), summed in the frequency domain.
-      h.assign(S, Complex(0.0, 0.0));
-      for (int s = 0; s < L; ++s) {
-        const auto& K = kernel_[t * L + s];
-#pragma omp parallel for
-        for (long q = 0; q < static_cast<long>(S); ++q)
-          h[q] -= K[kPair[k][0]][q] * m[s][0][q] + K[kPair[k][1]][q] * m[s][1][q] + K[kPair[k][2]][q] * m[s][2][q];
+  std::array<Spectrum, 3> h;
+  for (int t = 0; t < L; ++t) {
+    // (1): H_k = -sum_s sum_b N_kb^(ts) * M_b^(s), summed in the frequency domain.
+    for (auto& c : h) c.assign(S, Complex(0.0, 0.0));
+    for (int s = 0; s < L; ++s) {
+      const bool mirrored = s < t;
+      const auto& K = kernel_[mirrored ? s * L + t : t * L + s];
+      const auto &m0 = m[s][0], &m1 = m[s][1], &m2 = m[s][2];
+#pragma omp parallel for if (parallel())
+      for (long q = 0; q < static_cast<long>(S); ++q) {
+        Complex n[6];
+        for (int c = 0; c < 6; ++c) n[c] = mirrored ? std::conj(K[c][q]) : K[c][q];
+        h[0][q] -= multiply_add3(n[0], m0[q], n[1], m1[q], n[2], m2[q]);
+        h[1][q] -= multiply_add3(n[1], m0[q], n[3], m1[q], n[4], m2[q]);
+        h[2][q] -= multiply_add3(n[2], m0[q], n[4], m1[q], n[5], m2[q]);
       }
-      inverse(h, lattices_[t].n, grid);
+    }
+    for (int k = 0; k < 3; ++k) {
+      inverse(h[k], lattices_[t].n, grid);
       for (int c = first_[t]; c < first_[t + 1]; ++c) {
         const auto& ix = cell_index_[c];
         H[c][k] = grid[ix[1] + static_cast<size_t>(pad_[0]) * (ix[2] + static_cast<size_t>(pad_[1]) * ix[3])];
       }
     }
+  }
 }
 
 Vec3 LatticeDemag::force(int target, int source, const std::vector<Vec3>& M) const {
@@ -262,8 +282,9 @@ Vec3 LatticeDemag::force(int target, int source, const std::vector<Vec3>& M) con
     for (int a = k; a < 3; ++a) {
       q.assign(S, Complex(0.0, 0.0));
       const int c0 = triple(k, a, 0), c1 = triple(k, a, 1), c2 = triple(k, a, 2);
-#pragma omp parallel for
-      for (long e = 0; e < static_cast<long>(S); ++e) q[e] = G[c0][e] * ms[0][e] + G[c1][e] * ms[1][e] + G[c2][e] * ms[2][e];
+#pragma omp parallel for if (parallel())
+      for (long e = 0; e < static_cast<long>(S); ++e)
+        q[e] = multiply_add3(G[c0][e], ms[0][e], G[c1][e], ms[1][e], G[c2][e], ms[2][e]);
       inverse(q, lattices_[target].n, grid);
       for (int c = first_[target]; c < first_[target + 1]; ++c) {
         const auto& ix = cell_index_[c];

@@ -71,6 +71,9 @@ class LatticeDemag {
   void inverse(Spectrum& in, const std::array<int, 3>& used, std::vector<double>& out) const;
   void scatter(int lattice, const std::vector<Vec3>& M, int component, std::vector<double>& grid) const;
   Vec3 offset(int target, int source, const std::array<int, 3>& d) const;
+  // Threads only for grids large enough to pay for the parallel regions'
+  // start (a matvec opens a dozen of them).
+  bool parallel() const { return static_cast<long>(pad_[0]) * pad_[1] * pad_[2] >= (1L << 18); }
   void source_spectra(const std::vector<Vec3>& M, std::vector<std::array<Spectrum, 3>>& out) const;
 
   Vec3 cell_;
@@ -79,7 +82,7 @@ class LatticeDemag {
   std::vector<std::array<int, 4>> cell_index_;  // (lattice, i, j, k) of each active cell
   std::array<int, 3> pad_{0, 0, 0};             // padded FFT grid (even, 2-3-5 smooth)
   int half_x_ = 0;                              // pad_x / 2 + 1 (the real-to-complex half spectrum)
-  std::vector<std::array<Spectrum, 6>> kernel_;  // per (t, s) pair t * L + s: spectra of N's six components
+  std::vector<std::array<Spectrum, 6>> kernel_;  // per pair t <= s at t * L + s: spectra of N's six components
   std::vector<std::array<int, 2>> force_pairs_;
   std::vector<std::array<Spectrum, 10>> gradient_;  // per force pair: spectra of dN_ij/dd_k (symmetric, 10)
   std::array<double, 6> self_{};
