@@ -4,7 +4,7 @@
 // cell edges h (mm), with the setup time (kernel FFTs, coil field), the solve
 // time (Newton-GMRES from M = 0 at each excitation) and the iterations.
 //
-// Usage: team20 [--out DIR] [--h 5,2.5,1.6667,1.25] [--threads T]
+// Usage: team20 [--out DIR] [--h 5,2.5] [--threads T]
 // Writes DIR/team20.csv and DIR/team20.md (DIR: benchmarks/results). Runs
 // itself again with OMP_WAIT_POLICY=passive when that is unset.
 #include <omp.h>
@@ -31,7 +31,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 int main(int argc, char** argv) {
   bench::restart_with_passive_omp(argv);
   std::string out = "benchmarks/results";
-  std::vector<std::string> hs = {"5", "2.5", "1.6666666666666667", "1.25"};
+  std::vector<std::string> hs = {"5", "2.5"};
   int threads = 2;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
   std::fprintf(md,
                "# TEAM 20: force on the pole and gap flux density against the measured values\n\n"
                "benchmarks/team20 (docs/validation.md \"TEAM 20\"), %d thread(s). Solve: Newton-GMRES from M = 0, "
-               "tolerance 1e-7. Errors relative to the measured values (COMPEL 14(2/3), 1995).\n\n"
+               "tolerance 1e-4. Errors relative to the measured values (COMPEL 14(2/3), 1995).\n\n"
                "| h (mm) | cells | setup (s) | AT | solve (s) | Newton / GMRES | F (N) | meas. | err | Bz P1 (T) | "
                "err | Bz P2 (T) | err |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
                threads);
@@ -64,7 +64,9 @@ int main(int argc, char** argv) {
     for (const auto& m : team20::kMeasured) {
       std::vector<Vec3> M(p.demag.cells());
       const auto t1 = std::chrono::steady_clock::now();
-      const team20::Result r = team20::solve(p, m.ampere_turns, M);
+      BhSolveOptions options;
+      options.tolerance = 1e-4;  // the force is then converged to 5 digits (docs/validation.md "TEAM 20")
+      const team20::Result r = team20::solve(p, m.ampere_turns, M, options);
       const double solve = seconds_since(t1);
       const double F = -r.force_pole.z;  // toward the bar
       const double eF = F / m.force - 1.0, e1 = r.Bz_P1 / m.Bz_P1 - 1.0, e2 = r.Bz_P2 / m.Bz_P2 - 1.0;

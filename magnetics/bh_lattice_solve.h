@@ -8,11 +8,18 @@
 // f(H) = M(|H|) H / |H| the anhysteretic curve (magnetics/bh_curve.h,
 // extrapolated with dB/dH = mu0) and w_i the cell's volume share of steel
 // (1 inside, less for a cell the body's surface cuts: the cell's mean M).
-// Newton: (I + J N) dM = -G, J_i = w_i (chi_d h h^T + chi_s (I - h h^T)),
-// chi_d = dM/dH the differential (chord along H) and chi_s = M/|H| the secant
-// susceptibility (across H), h = H / |H|; solved by GMRES, right-
-// preconditioned with the cells' own blocks (I + J_i N(0))^-1, and a
-// backtracking line search on |G|.
+// Solved for the cells' field H instead (docs/model.md "Nonlinear static solve"):
+//   R(H) = H - H_source - H_d(w f(H)) = 0                                 (4)
+// by Newton, (I + N J) dH = -R, J_i = w_i (chi_d u u^T + chi_s (I - u u^T))
+// the cell law's Jacobian dM/dH, chi_d = dM/dH the differential (chord along
+// H) and chi_s = M/|H| the secant susceptibility (across H), u = H / |H|, and
+// N v = -H_d(v); the Newton system by GMRES (FFT matvecs), right-
+// preconditioned with the cells' own blocks (I + N(0) J_i)^-1, to the
+// Eisenstat-Walker forcing, and a backtracking line search on |R|. In H the
+// cell law is bounded (|M| <= Ms), so a step cannot overshoot saturation as
+// a step in M does; from M = 0 the solve starts at H = 0, whose first step is
+// the linear problem with the initial susceptibility. Converged when (3)'s
+// residual at M = w f(H) is below the tolerance.
 #pragma once
 
 #include <vector>
@@ -38,8 +45,8 @@ struct BhSolveReport {
   bool converged = false;
   int newton_iterations = 0;
   int krylov_iterations = 0;     // all GMRES iterations (one FFT matvec each)
-  double residual = 0.0;         // final |G| / |w f(H)|
-  std::vector<double> residuals; // after each Newton step, the first before any
+  double residual = 0.0;         // final |G| / |w f(H)| of (3)
+  std::vector<double> residuals; // the same, before the first and after each Newton step
 };
 
 // Solves (3) from the initial M (size demag.cells(); a previous solution, or

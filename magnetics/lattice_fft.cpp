@@ -52,6 +52,24 @@ Complex multiply_add3(const Complex& a0, const Complex& b0, const Complex& a1, c
               a2.real() * b2.imag() + a2.imag() * b2.real()};
 }
 
+// Transforms `count` complex lines of `length` points in place, line l at
+// data[base(l) + stride e]; an orphaned work-shared loop of the caller's
+// parallel region (a, b: the thread's scratch lines).
+template <class Base>
+void transform_lines(Eigen::FFT<double>& fft, bool inverse, std::vector<Complex>& data, int count, Base base,
+                     size_t stride, int length, std::vector<Complex>& a, std::vector<Complex>& b) {
+#pragma omp for
+  for (int l = 0; l < count; ++l) {
+    const size_t o = base(l);
+    for (int e = 0; e < length; ++e) a[e] = data[o + stride * e];
+    if (inverse)
+      fft.inv(b.data(), a.data(), length);
+    else
+      fft.fwd(b.data(), a.data(), length);
+    for (int e = 0; e < length; ++e) data[o + stride * e] = b[e];
+  }
+}
+
 // The pair tensor at real offset d (target centre - source centre): N (six
 // components) and, when g is not null, its gradient g[k][c] = dN_c / dd_k (cubes only).
 void pair_tensor(const Vec3& cell, const Vec3& d, double n[6], double (*g)[6]) {
@@ -163,19 +181,9 @@ void LatticeDemag::forward(const std::vector<double>& in, const std::array<int, 
       fft.fwd(b.data(), &in[static_cast<size_t>(px) * (y + py * z)], px);
       std::copy(b.begin(), b.begin() + hx, out.begin() + static_cast<size_t>(hx) * (y + py * z));
     }
-#pragma omp for
-    for (int xz = 0; xz < hx * used[2]; ++xz) {
-      const int x = xz % hx, z = xz / hx;
-      for (int y = 0; y < py; ++y) a[y] = out[x + static_cast<size_t>(hx) * (y + py * z)];
-      fft.fwd(b.data(), a.data(), py);
-      for (int y = 0; y < py; ++y) out[x + static_cast<size_t>(hx) * (y + py * z)] = b[y];
-    }
-#pragma omp for
-    for (int xy = 0; xy < hx * py; ++xy) {
-      for (int z = 0; z < pz; ++z) a[z] = out[xy + static_cast<size_t>(hx) * py * z];
-      fft.fwd(b.data(), a.data(), pz);
-      for (int z = 0; z < pz; ++z) out[xy + static_cast<size_t>(hx) * py * z] = b[z];
-    }
+    const size_t row = hx, plane = static_cast<size_t>(hx) * py;
+    transform_lines(fft, false, out, hx * used[2], [&](int l) { return l % hx + plane * (l / hx); }, row, py, a, b);
+    transform_lines(fft, false, out, hx * py, [](int l) { return static_cast<size_t>(l); }, plane, pz, a, b);
   }
 }
 
@@ -189,19 +197,9 @@ void LatticeDemag::inverse(Spectrum& in, const std::array<int, 3>& used, std::ve
     Eigen::FFT<double> fft;
     fft.SetFlag(Eigen::FFT<double>::HalfSpectrum);
     std::vector<Complex> a(std::max(py, pz)), b(std::max(py, pz));
-#pragma omp for
-    for (int xy = 0; xy < hx * py; ++xy) {
-      for (int z = 0; z < pz; ++z) a[z] = in[xy + static_cast<size_t>(hx) * py * z];
-      fft.inv(b.data(), a.data(), pz);
-      for (int z = 0; z < pz; ++z) in[xy + static_cast<size_t>(hx) * py * z] = b[z];
-    }
-#pragma omp for
-    for (int xz = 0; xz < hx * used[2]; ++xz) {
-      const int x = xz % hx, z = xz / hx;
-      for (int y = 0; y < py; ++y) a[y] = in[x + static_cast<size_t>(hx) * (y + py * z)];
-      fft.inv(b.data(), a.data(), py);
-      for (int y = 0; y < py; ++y) in[x + static_cast<size_t>(hx) * (y + py * z)] = b[y];
-    }
+    const size_t row = hx, plane = static_cast<size_t>(hx) * py;
+    transform_lines(fft, true, in, hx * py, [](int l) { return static_cast<size_t>(l); }, plane, pz, a, b);
+    transform_lines(fft, true, in, hx * used[2], [&](int l) { return l % hx + plane * (l / hx); }, row, py, a, b);
 #pragma omp for
     for (int yz = 0; yz < used[1] * used[2]; ++yz) {
       const int y = yz % used[1], z = yz / used[1];
