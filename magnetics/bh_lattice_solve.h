@@ -1,0 +1,61 @@
+// The static magnetization of fixed soft lattice bodies with a B-H curve in
+// an applied (coil) field, by Newton-Krylov on FFT matvecs (docs/model.md
+// "Nonlinear static solve").
+//
+// Unknowns: the mean magnetization M_i of every cell. Equations
+//   G_i(M) = M_i - w_i f(H_i) = 0,   H = H_source + H_d(M)               (3)
+// with H_d the cell-averaged demagnetizing field (magnetics/lattice_fft.h),
+// f(H) = M(|H|) H / |H| the anhysteretic curve (magnetics/bh_curve.h,
+// extrapolated with dB/dH = mu0) and w_i the cell's volume share of steel
+// (1 inside, less for a cell the body's surface cuts: the cell's mean M).
+// Solved for the cells' field H instead (docs/model.md "Nonlinear static solve"):
+//   R(H) = H - H_source - H_d(w f(H)) = 0                                 (4)
+// by Newton, (I + N J) dH = -R, J_i = w_i (chi_d u u^T + chi_s (I - u u^T))
+// the cell law's Jacobian dM/dH, chi_d = dM/dH the differential (chord along
+// H) and chi_s = M/|H| the secant susceptibility (across H), u = H / |H|, and
+// N v = -H_d(v); the Newton system by GMRES (FFT matvecs), right-
+// preconditioned with the cells' own blocks (I + N(0) J_i)^-1, to the
+// Eisenstat-Walker forcing, and a backtracking line search on |R|. In H the
+// cell law is bounded (|M| <= Ms), so a step cannot overshoot saturation as
+// a step in M does; from M = 0 the solve starts at H = 0, whose first step is
+// the linear problem with the initial susceptibility. Converged when (3)'s
+// residual at M = w f(H) is below the tolerance.
+#pragma once
+
+#include <vector>
+
+#include "magnetics/bh_curve.h"
+#include "magnetics/lattice_fft.h"
+#include "magnetics/vec3.h"
+
+namespace odemag {
+
+struct BhSolveOptions {
+  double tolerance = 1e-7;   // on |G| / |w f(H)| (2-norms over all cells)
+  int max_newton = 60;
+  // GMRES stops at the relative residual eta of the Newton system, eta by
+  // Eisenstat and Walker's choice 2 between min_forcing and forcing.
+  double forcing = 0.1;
+  double min_forcing = 1e-6;
+  int restart = 80;
+  int max_krylov = 3000;     // per Newton step
+};
+
+struct BhSolveReport {
+  bool converged = false;
+  int newton_iterations = 0;
+  int krylov_iterations = 0;     // all GMRES iterations (one FFT matvec each)
+  double residual = 0.0;         // final |G| / |w f(H)| of (3)
+  std::vector<double> residuals; // the same, before the first and after each Newton step
+};
+
+// Solves (3) from the initial M (size demag.cells(); a previous solution, or
+// zeros). fill and H_source per cell.
+BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, const std::vector<double>& fill,
+                               const std::vector<Vec3>& H_source, std::vector<Vec3>& M,
+                               const BhSolveOptions& options = {});
+
+// f(H) of (3) for one cell, and its Jacobian dM/dH (six components), times w.
+Vec3 bh_cell_law(const BhCurve& curve, double w, const Vec3& H, double jacobian[6]);
+
+}  // namespace odemag

@@ -1,0 +1,98 @@
+// FFT convolution of the demagnetizing tensor on lattices (magnetics/lattice_fft.h)
+// against the dense pairwise sums of the same tensors, and the Newton-Krylov
+// B-H solve (magnetics/bh_lattice_solve.h) on a soft cube against the curve.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "magnetics/bh_lattice_solve.h"
+#include "magnetics/constants.h"
+#include "magnetics/lattice_fft.h"
+#include "magnetics/rng.h"
+
+namespace odemag {
+namespace {
+
+// An irregular mask: about 70% of the cells, chosen by hash.
+LatticeGrid random_lattice(const Vec3& origin, std::array<int, 3> n, int seed) {
+  LatticeGrid g;
+  g.origin = origin;
+  g.n = n;
+  g.mask.resize(static_cast<size_t>(n[0]) * n[1] * n[2]);
+  for (size_t c = 0; c < g.mask.size(); ++c) g.mask[c] = unit_interval(hash_key(seed, static_cast<int>(c), 0, 0)) < 0.7;
+  return g;
+}
+
+std::vector<Vec3> random_magnetization(int cells, double scale) {
+  std::vector<Vec3> M(cells);
+  for (int i = 0; i < cells; ++i) M[i] = scale * random_unit_vector(hash_key(9, i, 0, 0));
+  return M;
+}
+
+double max_relative_difference(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  double d = 0.0, s = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    d = std::max(d, norm(a[i] - b[i]));
+    s = std::max(s, norm(b[i]));
+  }
+  return d / s;
+}
+
+// Two masked lattices, the second at a non-integer offset (in every axis) and
+// of another shape; the cells cuboids or cubes.
+LatticeDemag two_bodies(const Vec3& cell, bool forces) {
+  std::vector<LatticeGrid> g{random_lattice({0.0, 0.0, 0.0}, {5, 4, 3}, 1),
+                             random_lattice({0.37 * cell.x, -1.61 * cell.y, 3.3 * cell.z}, {3, 6, 4}, 2)};
+  std::vector<std::array<int, 2>> pairs;
+  if (forces) pairs = {{0, 1}, {1, 0}};
+  return LatticeDemag(cell, g, pairs);
+}
+
+TEST(LatticeFft, FieldEqualsTheDenseSumOfCuboidTensors) {
+  for (const Vec3 cell : {Vec3{1e-3, 1e-3, 1e-3}, Vec3{1e-3, 0.7e-3, 1.6e-3}}) {
+    const LatticeDemag demag = two_bodies(cell, false);
+    ASSERT_GT(demag.cells_of(0), 20);
+    ASSERT_GT(demag.cells_of(1), 20);
+    const auto M = random_magnetization(demag.cells(), 1e6);
+    std::vector<Vec3> fft, dense;
+    demag.field(M, fft);
+    demag.dense_field(M, dense);
+    EXPECT_LT(max_relative_difference(fft, dense), 1e-12) << cell.y;
+  }
+}
+
+TEST(LatticeFft, ForceEqualsTheDenseSumAndBalances) {
+  const LatticeDemag demag = two_bodies({2e-3, 2e-3, 2e-3}, true);
+  const auto M = random_magnetization(demag.cells(), 1e6);
+  const Vec3 F01 = demag.force(0, 1, M), F10 = demag.force(1, 0, M);
+  const Vec3 dense = demag.dense_force(0, 1, M);
+  EXPECT_LT(norm(F01 - dense), 1e-11 * norm(dense));
+  EXPECT_LT(norm(F01 + F10), 1e-11 * norm(F01));  // momentum balance F_01 = -F_10
+}
+
+// One soft cube of 4^3 cells in a uniform field: the solve converges, and the
+// mean M sits on the curve at the mean internal field (a cube's mean field is
+// H_A - N M with N about 1/3; checked as M = M(|H|) cell by cell).
+TEST(BhLatticeSolve, SoftCubeConvergesOntoTheCurve) {
+  const BhCurve curve({{0.0, 0.0}, {100.0, 0.5}, {300.0, 1.2}, {1000.0, 1.5}, {1e4, 1.8}});
+  LatticeGrid g;
+  g.n = {4, 4, 4};
+  g.mask.assign(64, 1);
+  const LatticeDemag demag({1e-3, 1e-3, 1e-3}, {g});
+  for (const double Ha : {1e3, 3e5, 2e6}) {
+    const std::vector<double> fill(64, 1.0);
+    const std::vector<Vec3> source(64, Vec3{0.0, 0.0, Ha});
+    std::vector<Vec3> M(64);
+    const BhSolveReport report = solve_bh_lattice(demag, curve, fill, source, M);
+    EXPECT_TRUE(report.converged) << Ha;
+    std::vector<Vec3> Hd;
+    demag.field(M, Hd);
+    for (int i = 0; i < 64; ++i) {
+      const Vec3 H = source[i] + Hd[i];
+      EXPECT_NEAR(norm(M[i]), curve.magnetization(norm(H)), 1e-6 * curve.saturation()) << Ha;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace odemag
