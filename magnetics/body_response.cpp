@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "magnetics/eigen_tensors.h"
 #include "magnetics/model.h"
 
 namespace odemag {
@@ -24,23 +25,6 @@ bool takes_body_response(const MagneticBody& body) {
          body.soft.gamma_D <= 1.0 / 3.0 + 1e-2;
 }
 
-namespace {
-
-Eigen::Matrix3d symmetric(const double* t) {
-  Eigen::Matrix3d m;
-  m << t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5];
-  return m;
-}
-
-Eigen::Matrix3d matrix(const Mat3& a) {
-  Eigen::Matrix3d m;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) m(r, c) = a.m[r][c];
-  return m;
-}
-
-}  // namespace
-
 // S = I - W^1/2 K W^1/2 / gamma_D, K_ij the field at cell i per unit moment
 // at cell j inside the body: the offset tensors T(l_i - l_j) (i != j), the
 // boundary correction's self tensors S_i (i = j) and its uniform-mode terms
@@ -54,17 +38,17 @@ std::shared_ptr<const BodyResponseFactor> build_body_response(const MagneticBody
   auto factor = std::make_shared<BodyResponseFactor>();
   factor->sqrt_volume.resize(3 * n);
   for (int i = 0; i < n; ++i) factor->sqrt_volume.segment<3>(3 * i).setConstant(std::sqrt(cells.volumes[i]));
-  const Eigen::Matrix3d G_pi = boundary ? matrix(body.uniform_inverse[0]) : Eigen::Matrix3d::Zero();
-  const Eigen::Matrix3d G_beta = boundary ? matrix(body.uniform_inverse[1]) : Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d G_pi = boundary ? eigen_matrix(body.uniform_inverse[0]) : Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d G_beta = boundary ? eigen_matrix(body.uniform_inverse[1]) : Eigen::Matrix3d::Zero();
   Eigen::MatrixXd S = Eigen::MatrixXd::Identity(3 * n, 3 * n);
   for (int j = 0; j < n; ++j) {
     for (int i = j; i < n; ++i) {  // the lower triangle: all LLT reads
       Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
-      if (i != j) K = symmetric(&body.offset_tensors[6u * body.offset_index(cells.lattice_index[i], cells.lattice_index[j])]);
+      if (i != j) K = symmetric_matrix(&body.offset_tensors[6u * body.offset_index(cells.lattice_index[i], cells.lattice_index[j])]);
       if (boundary) {
-        if (i == j) K += symmetric(&body.self_tensors[6u * i]);
-        K += symmetric(&body.uniform_tensors[12u * i]) * G_pi * symmetric(&body.uniform_tensors[12u * j]) -
-             symmetric(&body.uniform_tensors[12u * i + 6]) * G_beta * symmetric(&body.uniform_tensors[12u * j + 6]);
+        if (i == j) K += symmetric_matrix(&body.self_tensors[6u * i]);
+        K += symmetric_matrix(&body.uniform_tensors[12u * i]) * G_pi * symmetric_matrix(&body.uniform_tensors[12u * j]) -
+             symmetric_matrix(&body.uniform_tensors[12u * i + 6]) * G_beta * symmetric_matrix(&body.uniform_tensors[12u * j + 6]);
       }
       const double scale = std::sqrt(cells.volumes[i] * cells.volumes[j]) / body.soft.gamma_D;
       S.block<3, 3>(3 * i, 3 * j) -= scale * K;

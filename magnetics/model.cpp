@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "magnetics/eigen_tensors.h"
 #include "magnetics/kernels.h"
 
 namespace odemag {
@@ -115,12 +116,7 @@ void build_boundary_correction(MagneticBody& body) {
       const double v = cells.volumes[j];  // w_j N = -T V_j
       for (int a = 0; a < 6; ++a) sum[a] -= v * t[a];
     }
-    auto matrix = [](const double* t) {
-      Eigen::Matrix3d m;
-      m << t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5];
-      return m;
-    };
-    const Eigen::Matrix3d S = matrix(sum), Nbar = matrix(nbar), I = Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d S = symmetric_matrix(sum), Nbar = symmetric_matrix(nbar), I = Eigen::Matrix3d::Identity();
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I / 3.0 + S - Nbar);
     Eigen::Vector3d e = eig.eigenvalues();  // ascending
     const double cap = (1.0 - cells.volumes[i] / cells.cell_volume) / 3.0;
@@ -145,10 +141,7 @@ void build_boundary_correction(MagneticBody& body) {
   for (int k = 0; k < 2; ++k) {
     Eigen::Matrix3d total = Eigen::Matrix3d::Zero();
     for (int i = 0; i < count; ++i) {
-      const double* t = &body.uniform_tensors[12u * i + 6u * k];
-      Eigen::Matrix3d m;
-      m << t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5];
-      total += cells.volumes[i] * m;
+      total += cells.volumes[i] * symmetric_matrix(&body.uniform_tensors[12u * i + 6u * k]);
     }
     const Eigen::Matrix3d inv = total.inverse();
     for (int r = 0; r < 3; ++r)
