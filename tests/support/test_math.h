@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "magnetics/eigen_tensors.h"
 #include "magnetics/vec3.h"
 
 namespace odemag::test_support {
@@ -15,20 +16,8 @@ inline Mat3 axis_rotation(const Vec3& axis, double angle) {
   return rotation_from_quaternion(std::cos(angle / 2), s * a.x, s * a.y, s * a.z);
 }
 
-// A symmetric 3x3 tensor stored as its 6 upper components (xx, xy, xz, yy,
-// yz, zz; magnetics/model.h) as an Eigen matrix.
-inline Eigen::Matrix3d symmetric_matrix(const double* t) {
-  Eigen::Matrix3d m;
-  m << t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5];
-  return m;
-}
-
-// A Mat3 as an Eigen matrix.
-inline Eigen::Matrix3d eigen_matrix(const Mat3& a) {
-  Eigen::Matrix3d m;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) m(r, c) = a.m[r][c];
-  return m;
-}
+// Tensors as Eigen matrices: the library's (magnetics/eigen_tensors.h).
+using odemag::eigen_matrix;
+using odemag::symmetric_matrix;
 
 }  // namespace odemag::test_support
