@@ -83,8 +83,11 @@
 // (IntraBodyTensor::point_dipole: there a body's own cells are point dipoles too).
 //
 // Cost: the halves of an 8^3 cube have 2364 pairs (8 pieces: 6196); build
-// about 10 us per pair, forces (the gradient, two frames) 7-20 us per pair on
-// the 2-core test machine; each field evaluation two 3 x 3 products per pair.
+// about 10 us per pair (the cube tensor and its gradient in each frame, once
+// when the two bodies' rotations are equal bit for bit), kept for the forces
+// at the same pose, which then cost a few 3 x 3 products per pair; each field
+// evaluation two 3 x 3 products per pair. (Computing the tensors again in the
+// forces, and in both frames, was 83% of the thin-plate scene's time.)
 //
 // Pair search (build): bodies first, by the bounding spheres of their cell
 // points; then the cells of each body within reach of the other's sphere; then
@@ -234,34 +237,47 @@ double pair_volume(const MagneticModel& model, int i, int j) {
   return std::sqrt(model.body(model.cell_body(i)).cells.cell_volume * model.body(model.cell_body(j)).cells.cell_volume);
 }
 
-// One body frame's share of a pair: T_X = R D(R^T d) R^T (world) and, given the
-// moments, phi = mu_i . T_X mu_j, the fields T_X mu_j, T_X mu_i at i and j,
-// and grad = grad_d phi.
+// A pair's tensor in one body frame X, at the local offset R_X^T d: D and its
+// gradient dD[k] = dD / d(local offset)_k (cube_pair_tensor).
+struct LocalTensor {
+  double D[6];
+  double dD[3][6];
+};
+
+LocalTensor local_tensor(const Mat3& R, const Vec3& d, double h, double volume) {
+  LocalTensor t;
+  const Vec3 dl = R.transpose_times(d);
+  const double local[3] = {dl.x, dl.y, dl.z};
+  cube_pair_tensor(local, h, volume, t.D, t.dD);
+  return t;
+}
+
+// One body frame's share of a pair, given the moments: phi = mu_i . T_X mu_j
+// (T_X = R D R^T, world), the fields T_X mu_j, T_X mu_i at i and j, and
+// grad = grad_d phi.
 struct FrameShare {
-  double t[6];
   double phi = 0.0;
   Vec3 H_i, H_j, grad;
 };
 
-FrameShare frame_share(const Mat3& R, const Vec3& d, double h, double volume, const Vec3* mu_i, const Vec3* mu_j) {
+FrameShare frame_share(const Mat3& R, const LocalTensor& t, const Vec3& mu_i, const Vec3& mu_j) {
   FrameShare f;
-  const Vec3 dl = R.transpose_times(d);
-  const double local[3] = {dl.x, dl.y, dl.z};
-  const bool with_moments = mu_i && mu_j;
-  double D[6], dD[3][6];
-  cube_pair_tensor(local, h, volume, D, with_moments ? dD : nullptr);
-  rotate_symmetric(R, D, f.t);
-  if (with_moments) {
-    const Vec3 mi = R.transpose_times(*mu_i), mj = R.transpose_times(*mu_j);
-    const Vec3 Dmj = symmetric_times(D, mj), Dmi = symmetric_times(D, mi);
-    f.phi = dot(mi, Dmj);
-    f.H_i = R * Dmj;
-    f.H_j = R * Dmi;
-    Vec3 g;
-    for (int k = 0; k < 3; ++k) g[k] = dot(mi, symmetric_times(dD[k], mj));
-    f.grad = R * g;
-  }
+  const Vec3 mi = R.transpose_times(mu_i), mj = R.transpose_times(mu_j);
+  const Vec3 Dmj = symmetric_times(t.D, mj), Dmi = symmetric_times(t.D, mi);
+  f.phi = dot(mi, Dmj);
+  f.H_i = R * Dmj;
+  f.H_j = R * Dmi;
+  Vec3 g;
+  for (int k = 0; k < 3; ++k) g[k] = dot(mi, symmetric_times(t.dD[k], mj));
+  f.grad = R * g;
   return f;
+}
+
+bool same_rotation(const Mat3& a, const Mat3& b) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      if (a.m[r][c] != b.m[r][c]) return false;
+  return true;
 }
 
 // Two bodies whose lattices are aligned closely enough to be corrected.
@@ -270,12 +286,20 @@ struct BodyLink {
   double h = 0.0;
   Window align;      // w_a(c)
   Vec3 dc_dtheta_b;  // dc / dtheta of turning body b (world); body a: the opposite
+  Mat3 rotation_a, rotation_b;  // the poses the pairs' tensors were built at
+  bool same_frames = false;     // rotation_a == rotation_b bit for bit: T_B = T_A
 };
 
 struct CellPair {
   int i = 0, j = 0;  // cells of link.a and link.b
   int link = 0;
   double K[6];       // world
+  // The build's frame tensors with their gradients, kept for the forces at the
+  // same pose (cube_demag_tensor_at is most of this term's cost), and the
+  // offset d they were computed at.
+  Vec3 d;
+  double volume = 0.0;
+  LocalTensor frame_a, frame_b;
 };
 
 // A body's bounding sphere about its cells' centroid and the rigid
@@ -349,9 +373,18 @@ class LatticeNearField final : public NearFieldTerm {
       const double dn = norm(d);
       const Window wr = radial_window(dn, l.h);
       const double w = l.align.w * wr.w;
-      const double volume = pair_volume(model, p.i, p.j);
-      const FrameShare A = frame_share(state.pose[l.a].rotation, d, l.h, volume, &mu_i, &mu_j);
-      const FrameShare B = frame_share(state.pose[l.b].rotation, d, l.h, volume, &mu_i, &mu_j);
+      // The build's tensors where the pose is the build's (the backends build
+      // and then take forces at one pose); else computed here.
+      const Mat3 &Ra = state.pose[l.a].rotation, &Rb = state.pose[l.b].rotation;
+      const bool built_here = same_rotation(Ra, l.rotation_a) && same_rotation(Rb, l.rotation_b) &&
+                              d.x == p.d.x && d.y == p.d.y && d.z == p.d.z;
+      LocalTensor ta, tb;
+      if (!built_here) {
+        ta = local_tensor(Ra, d, l.h, p.volume);
+        tb = same_rotation(Ra, Rb) ? ta : local_tensor(Rb, d, l.h, p.volume);
+      }
+      const FrameShare A = frame_share(Ra, built_here ? p.frame_a : ta, mu_i, mu_j);
+      const FrameShare B = frame_share(Rb, built_here ? p.frame_b : tb, mu_i, mu_j);
       // The dense kernel's share, at the cell points with the pair's contact distance.
       const double s = model.cell_contact_radius(p.i) + model.cell_contact_radius(p.j);
       const Vec3 Tk_mu_j = dipole_field(r, mu_j, s * s), Tk_mu_i = dipole_field(r, mu_i, s * s);
@@ -427,6 +460,9 @@ class LatticeNearField final : public NearFieldTerm {
     // Turning body b by dtheta: E -> E + [R_A^T dtheta]x E, so dtr(E)/dtheta_b = R_A v.
     const Vec3 v{E.m[1][2] - E.m[2][1], E.m[2][0] - E.m[0][2], E.m[0][1] - E.m[1][0]};
     link.dc_dtheta_b = -(Ra * v);
+    const Mat3& Rb = state.pose[b].rotation;
+    link.rotation_a = Ra, link.rotation_b = Rb;
+    link.same_frames = same_rotation(Ra, Rb);
     // The cells of each body within reach of the other's sphere, then their pairs.
     auto near_cells = [&](const MagneticBody& body, const LatticeBody& other) {
       std::vector<int> cells;
@@ -446,13 +482,17 @@ class LatticeNearField final : public NearFieldTerm {
         if (wr.w == 0.0) continue;
         CellPair p;
         p.i = i, p.j = j, p.link = link_index;
-        const double volume = pair_volume(model, i, j);
-        const FrameShare sa = frame_share(Ra, d, h, volume, nullptr, nullptr);
-        const FrameShare sb = frame_share(state.pose[b].rotation, d, h, volume, nullptr, nullptr);
+        p.d = d;
+        p.volume = pair_volume(model, i, j);
+        p.frame_a = local_tensor(Ra, d, h, p.volume);
+        p.frame_b = link.same_frames ? p.frame_a : local_tensor(Rb, d, h, p.volume);
+        double ta[6], tb[6];
+        rotate_symmetric(Ra, p.frame_a.D, ta);
+        rotate_symmetric(Rb, p.frame_b.D, tb);
         const double s = model.cell_contact_radius(i) + model.cell_contact_radius(j);
         double t[6];
         dipole_tensor(d, s * s, t);
-        for (int m = 0; m < 6; ++m) p.K[m] = link.align.w * wr.w * (0.5 * (sa.t[m] + sb.t[m]) - t[m]);
+        for (int m = 0; m < 6; ++m) p.K[m] = link.align.w * wr.w * (0.5 * (ta[m] + tb[m]) - t[m]);
         pairs_.push_back(p);
       }
     if (pairs_.size() > first_pair) links_.push_back(link);

@@ -61,6 +61,11 @@
 // tolerance, so their numbers round differently; iron_plate and
 // thin_iron_plate moved, ball_chain and nail_and_balls (no body takes it)
 // kept their hashes. Outcomes in docs/scenes.md "stop 27".
+// Re-pinned (stop 28) for the lattice near field's forces taking the tensors
+// of its build (magnetics/lattice_near_field.cpp): the same arithmetic, but
+// the compiler contracts a few products into FMAs differently (built with
+// -ffp-contract=off, the old and the new code give identical hashes in every
+// scene); iron_plate and thin_iron_plate moved.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -122,8 +127,8 @@ struct Case {
 
 const Case kCases[] = {
     {"ball_chain", 1.5, 0x777ed691b1b85390ULL},
-    {"iron_plate", 1.7, 0xc095830c7cd17eccULL},
-    {"thin_iron_plate", 1.0, 0xb1b2f30780423639ULL},
+    {"iron_plate", 1.7, 0xa762fef82f9adb80ULL},
+    {"thin_iron_plate", 1.0, 0x4a2e905d7909b778ULL},
     {"nail_and_balls", 3.2, 0xbab5752d069f5028ULL},
 };
 
