@@ -66,6 +66,13 @@
 // the compiler contracts a few products into FMAs differently (built with
 // -ffp-contract=off, the old and the new code give identical hashes in every
 // scene); iron_plate and thin_iron_plate moved.
+// Re-pinned (stop 29) for carried-over sphere pairs: a pair of one-cell
+// spheres whose centre distance moved by at most 1e-5 of its gap (and of
+// R_a + R_b) since its coefficients were evaluated keeps them, K carried to
+// first order (magnetics/sphere_near_field.cpp; fields off by ~1e-10, forces
+// by ~2.5e-6 of a close pair's force). Every scene with sphere pairs
+// moved (ball_chain, thin_iron_plate, nail_and_balls); iron_plate, without
+// them, kept its hash. Outcomes in docs/scenes.md "stop 29".
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -126,10 +133,10 @@ struct Case {
 };
 
 const Case kCases[] = {
-    {"ball_chain", 1.5, 0x777ed691b1b85390ULL},
+    {"ball_chain", 1.5, 0x6882c506e7d91dcdULL},
     {"iron_plate", 1.7, 0xa762fef82f9adb80ULL},
-    {"thin_iron_plate", 1.0, 0x4a2e905d7909b778ULL},
-    {"nail_and_balls", 3.2, 0xbab5752d069f5028ULL},
+    {"thin_iron_plate", 1.0, 0xb2b1f737582e0fbfULL},
+    {"nail_and_balls", 3.2, 0x401f76e350eb60cfULL},
 };
 
 // Set by tests/engine/CMakeLists.txt for a Release build with
