@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
       const double eF = F / m.force - 1.0, e1 = r.Bz_P1 / m.Bz_P1 - 1.0, e2 = r.Bz_P2 / m.Bz_P2 - 1.0;
       const double balance = norm(r.force_from_yoke + r.force_on_yoke) / norm(r.force_from_yoke);
       std::fprintf(csv, "%.4f,%d,%d,%d,%.3f,%.0f,%.3f,%d,%d,%.2e,%.3f,%.1f,%.4f,%.4f,%.2f,%.4f,%.4f,%.2f,%.4f,%.1e\n", h,
-                   p.demag.cells(), p.demag.cells_of(0), threads, setup, m.ampere_turns, solve,
+                   p.demag.cells(), p.pole_cells(), threads, setup, m.ampere_turns, solve,
                    r.report.newton_iterations, r.report.krylov_iterations, r.report.residual, F, m.force, eF, r.Bz_P1,
                    m.Bz_P1, e1, r.Bz_P2, m.Bz_P2, e2, balance);
       std::fprintf(md, "| %.3g | %d | %.2f | %.0f | %.3f | %d / %d | %.2f | %.1f | %+.1f%% | %.3f | %+.1f%% | %.3f | %+.1f%% |\n",
