@@ -95,10 +95,10 @@ inline RoundedRectangleCoil coil(double ampere_turns) {
 
 inline const Vec3 kP1{0.0, 0.0, 25.75 * kMm}, kP2{12.5 * kMm, 5 * kMm, 25.75 * kMm};
 
-// Lattice of cells of edges e (spacing h) with cell (0, 0, 0) spanning
-// [corner, corner + e] and n cells per axis; a cell where it lies inside the
-// boxes (every cell all steel or none, by the rule above).
-inline LatticeGrid box_lattice(const Vec3& corner, double h, const std::array<int, 3>& n,
+// Lattice of cells of edges e (spacing h per axis) with cell (0, 0, 0)
+// spanning [corner, corner + e] and n cells per axis; a cell where it lies
+// inside the boxes (every cell all steel or none, by the rule above).
+inline LatticeGrid box_lattice(const Vec3& corner, const Vec3& h, const std::array<int, 3>& n,
                                const std::vector<Box>& boxes, const Vec3& e) {
   LatticeGrid g;
   g.origin = corner + 0.5 * e;
@@ -108,7 +108,7 @@ inline LatticeGrid box_lattice(const Vec3& corner, double h, const std::array<in
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
       for (int i = 0; i < n[0]; ++i) {
-        const Vec3 c = g.origin + Vec3{i * h, j * h, k * h};
+        const Vec3 c = g.origin + Vec3{i * h.x, j * h.y, k * h.z};
         for (const Box& b : boxes)
           if (c.x > b.lo.x && c.x < b.hi.x && c.y > b.lo.y && c.y < b.hi.y && c.z > b.lo.z && c.z < b.hi.z)
             g.mask[i + static_cast<size_t>(n[0]) * (j + static_cast<size_t>(n[1]) * k)] = 1;
@@ -116,9 +116,10 @@ inline LatticeGrid box_lattice(const Vec3& corner, double h, const std::array<in
   return g;
 }
 
-// The discretized problem at cell edge h (mm; 25 / h and 10 / h integers).
+// The discretized problem at cell edges h = (hx, hy, hz) (mm; 25 / hx,
+// 10 / hy, 25 / hy and 25 / hz integers): cubes, or cuboids coarser along z.
 struct Problem {
-  double h = 0.0;  // m
+  Vec3 h;  // m
   bool balance = false;
   std::vector<Vec3> coil_H;          // coil field at 1 A-turn at the cell centres, A/m
   std::vector<std::array<Vec3, 3>> coil_gradient;  // pole cells: d(coil_H)/dx_a (row a), 1 A-turn
@@ -126,49 +127,51 @@ struct Problem {
   LatticeDemag demag;
   BhCurve curve{bh_table()};
 
-  // Lattices: the pole's (its cubes, then its top layer when h does not
-  // divide 98.5 mm), then the yoke's: the bottom bar's cubes, its end layers
-  // (when h does not divide 51 mm), the left and right column with its top bar.
-  static LatticeDemag make(double h, bool balance, int& pole_lattices) {
-    const double eps = 1e-9 * h;
-    auto whole = [h, eps](double length_mm) { return static_cast<int>(std::floor((length_mm * kMm + eps) / h)); };
+  // Lattices: the pole's (its cells, then its top layer when hz does not
+  // divide 98.5 mm), then the yoke's: the bottom bar's cells, its end layers
+  // (when hx does not divide 51 mm), the left and right column with its top bar.
+  static LatticeDemag make(const Vec3& h, bool balance, int& pole_lattices) {
+    auto whole = [](double length_mm, double edge) {
+      return static_cast<int>(std::floor((length_mm * kMm + 1e-9 * edge) / edge));
+    };
     const auto yoke = yoke_boxes();
     const std::vector<Box> pole = pole_boxes(), bar{yoke[0]}, left{yoke[1], yoke[3]}, right{yoke[2], yoke[4]};
-    const Vec3 cube{h, h, h};
-    const int px = whole(25.0), py = whole(10.0), pz = whole(98.5), y = whole(25.0);
+    const int px = whole(25.0, h.x), py = whole(10.0, h.y), pz = whole(98.5, h.z), y = whole(25.0, h.y);
+    const int bar_z = whole(25.0, h.z), side_x = whole(50.0, h.x), side_z = whole(125.0, h.z);
     std::vector<LatticeGrid> g;
-    g.push_back(box_lattice({-12.5 * kMm, -5 * kMm, 26.5 * kMm}, h, {px, py, pz}, pole, cube));
-    const double top = 98.5 * kMm - pz * h;  // the pole's top layer
-    if (top > eps) g.push_back(box_lattice({-12.5 * kMm, -5 * kMm, 125 * kMm - top}, h, {px, py, 1}, pole, {h, h, top}));
+    g.push_back(box_lattice({-12.5 * kMm, -5 * kMm, 26.5 * kMm}, h, {px, py, pz}, pole, h));
+    const double top = 98.5 * kMm - pz * h.z;  // the pole's top layer
+    if (top > 1e-9 * h.z)
+      g.push_back(box_lattice({-12.5 * kMm, -5 * kMm, 125 * kMm - top}, h, {px, py, 1}, pole, {h.x, h.y, top}));
     pole_lattices = static_cast<int>(g.size());
-    const int k = whole(51.0);
-    const double reach = 12.5 * kMm + k * h, end = 63.5 * kMm - reach;  // the bar's cubes reach |x| = reach
-    g.push_back(box_lattice({-reach, -12.5 * kMm, 0.0}, h, {2 * k + px, y, whole(25.0)}, bar, cube));
-    if (end > eps) {
-      g.push_back(box_lattice({-63.5 * kMm, -12.5 * kMm, 0.0}, h, {1, y, whole(25.0)}, bar, {end, h, h}));
-      g.push_back(box_lattice({reach, -12.5 * kMm, 0.0}, h, {1, y, whole(25.0)}, bar, {end, h, h}));
+    const int k = whole(51.0, h.x);
+    const double reach = 12.5 * kMm + k * h.x, end = 63.5 * kMm - reach;  // the bar's cells reach |x| = reach
+    g.push_back(box_lattice({-reach, -12.5 * kMm, 0.0}, h, {2 * k + px, y, bar_z}, bar, h));
+    if (end > 1e-9 * h.x) {
+      g.push_back(box_lattice({-63.5 * kMm, -12.5 * kMm, 0.0}, h, {1, y, bar_z}, bar, {end, h.y, h.z}));
+      g.push_back(box_lattice({reach, -12.5 * kMm, 0.0}, h, {1, y, bar_z}, bar, {end, h.y, h.z}));
     }
-    g.push_back(box_lattice({-63.5 * kMm, -12.5 * kMm, 25 * kMm}, h, {whole(50.0), y, whole(125.0)}, left, cube));
-    g.push_back(box_lattice({13.5 * kMm, -12.5 * kMm, 25 * kMm}, h, {whole(50.0), y, whole(125.0)}, right, cube));
+    g.push_back(box_lattice({-63.5 * kMm, -12.5 * kMm, 25 * kMm}, h, {side_x, y, side_z}, left, h));
+    g.push_back(box_lattice({13.5 * kMm, -12.5 * kMm, 25 * kMm}, h, {side_x, y, side_z}, right, h));
     std::vector<std::array<int, 2>> pairs;
     for (int t = 0; t < pole_lattices; ++t)
       for (int s = pole_lattices; s < static_cast<int>(g.size()); ++s) {
         pairs.push_back({t, s});
         if (balance) pairs.push_back({s, t});
       }
-    return LatticeDemag(cube, g, pairs);
+    return LatticeDemag(h, g, pairs);
   }
 
   int pole_cells() const { return demag.first_cell(pole_lattices); }
 
   // balance: also the forces on the yoke from the pole (the momentum check).
-  explicit Problem(double h_mm, bool with_balance = false)
-      : h(h_mm * kMm), balance(with_balance), demag(make(h, with_balance, pole_lattices)) {
+  explicit Problem(const Vec3& h_mm, bool with_balance = false)
+      : h(kMm * h_mm), balance(with_balance), demag(make(h, with_balance, pole_lattices)) {
     const RoundedRectangleCoil unit = coil(1.0);
     const int N = demag.cells(), pole = pole_cells();
     coil_H.resize(N);
     coil_gradient.resize(pole);
-    const double d = 1e-2 * h;  // central differences of the smooth coil field (the pole is 7 mm from the copper)
+    const double d = 1e-2 * std::min({h.x, h.y, h.z});  // central differences of the smooth coil field (the pole is 7 mm from the copper)
 #pragma omp parallel for schedule(dynamic, 8)
     for (int i = 0; i < N; ++i) {
       const Vec3 c = demag.centre(i);
@@ -181,6 +184,7 @@ struct Problem {
         }
     }
   }
+  explicit Problem(double h_mm, bool with_balance = false) : Problem(Vec3{h_mm, h_mm, h_mm}, with_balance) {}
 };
 
 struct Result {
