@@ -1,11 +1,12 @@
 // The demagnetizing field of lattice bodies by FFT convolution
 // (docs/model.md "FFT convolution on lattices").
 //
-// Cells are uniformly magnetized cuboids of one size (hx, hy, hz), axis
-// aligned, on regular lattices: lattice l has n[l] cells per axis with cell
+// Cells are uniformly magnetized cuboids, axis aligned, on regular lattices
+// of one spacing (hx, hy, hz): lattice l has n[l] cells per axis with cell
 // (i, j, k) centred at origin + (i hx, j hy, k hz); the cells of a body are a
-// mask on its lattice. Lattices share the cell size and the orientation but
-// their origins differ arbitrarily (not by multiples of h). The mean field over
+// mask on its lattice; a cell's edges are the spacing unless the lattice
+// says otherwise (layers, below). Lattices share the spacing and the
+// orientation but their origins differ arbitrarily (not by multiples of h). The mean field over
 // cell i of lattice t is
 //   H_i = -sum_s sum_j N(r_i - r_j) M_j                                  (1)
 // with N the cell-averaged cuboid-cuboid tensor (cuboid_demag_tensor, the
