@@ -4,7 +4,8 @@
 // cell edges h (mm), with the setup time (kernel FFTs, coil field), the solve
 // time (Newton-GMRES from M = 0 at each excitation) and the iterations.
 //
-// Usage: team20 [--out DIR] [--h 5,2.5] [--threads T]
+// Usage: team20 [--out DIR] [--h 5,2.5x2.5x5,2.5] [--threads T]
+// (an edge h, or the edges hx x hy x hz, in mm).
 // Writes DIR/team20.csv and DIR/team20.md (DIR: benchmarks/results). Runs
 // itself again with OMP_WAIT_POLICY=passive when that is unset.
 #include <omp.h>
@@ -22,6 +23,22 @@ using namespace odemag;
 
 namespace {
 
+// "h" or "hx x hy x hz" (mm).
+Vec3 edges(const std::string& s) {
+  Vec3 h;
+  size_t at = 0;
+  for (int a = 0; a < 3; ++a) {
+    const size_t x = s.find('x', at);
+    h[a] = std::stod(s.substr(at, x == std::string::npos ? std::string::npos : x - at));
+    if (x == std::string::npos) {
+      for (int b = a + 1; b < 3; ++b) h[b] = h[a];
+      break;
+    }
+    at = x + 1;
+  }
+  return h;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -31,7 +48,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 int main(int argc, char** argv) {
   bench::restart_with_passive_omp(argv);
   std::string out = "benchmarks/results";
-  std::vector<std::string> hs = {"5", "2.5"};
+  std::vector<std::string> hs = {"5", "2.5x2.5x5", "2.5"};
   int threads = 2;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -39,7 +56,7 @@ int main(int argc, char** argv) {
     else if (a == "--h") hs = bench::split(bench::option_value(argc, argv, i, "team20"));
     else if (a == "--threads") threads = std::stoi(bench::option_value(argc, argv, i, "team20"));
     else {
-      std::fprintf(stderr, "usage: team20 [--out DIR] [--h 5,2.5,...] [--threads T]\n");
+      std::fprintf(stderr, "usage: team20 [--out DIR] [--h 5,2.5x2.5x5,...] [--threads T]\n");
       return 2;
     }
   }
@@ -47,7 +64,7 @@ int main(int argc, char** argv) {
   FILE *csv = nullptr, *md = nullptr;
   if (!bench::open_reports(out, out + "/team20.csv", out + "/team20.md", csv, md)) return 1;
   std::fprintf(csv,
-               "h_mm,cells,pole_cells,threads,setup_s,ampere_turns,solve_s,newton,gmres,residual,force_N,force_measured_N,"
+               "hx_mm,hy_mm,hz_mm,cells,pole_cells,threads,setup_s,ampere_turns,solve_s,newton,gmres,residual,force_N,force_measured_N,"
                "force_error,Bz_P1_T,Bz_P1_measured_T,Bz_P1_error,Bz_P2_T,Bz_P2_measured_T,Bz_P2_error,momentum_balance\n");
   std::fprintf(md,
                "# TEAM 20: force on the pole and gap flux density against the measured values\n\n"
@@ -57,7 +74,7 @@ int main(int argc, char** argv) {
                "err | Bz P2 (T) | err |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
                threads);
   for (const std::string& hstr : hs) {
-    const double h = std::stod(hstr);
+    const Vec3 h = edges(hstr);
     const auto t0 = std::chrono::steady_clock::now();
     const team20::Problem p(h, true);
     const double setup = seconds_since(t0);
@@ -71,16 +88,16 @@ int main(int argc, char** argv) {
       const double F = -r.force_pole.z;  // toward the bar
       const double eF = F / m.force - 1.0, e1 = r.Bz_P1 / m.Bz_P1 - 1.0, e2 = r.Bz_P2 / m.Bz_P2 - 1.0;
       const double balance = norm(r.force_from_yoke + r.force_on_yoke) / norm(r.force_from_yoke);
-      std::fprintf(csv, "%.4f,%d,%d,%d,%.3f,%.0f,%.3f,%d,%d,%.2e,%.3f,%.1f,%.4f,%.4f,%.2f,%.4f,%.4f,%.2f,%.4f,%.1e\n", h,
-                   p.demag.cells(), p.demag.cells_of(0), threads, setup, m.ampere_turns, solve,
+      std::fprintf(csv, "%.4f,%.4f,%.4f,%d,%d,%d,%.3f,%.0f,%.3f,%d,%d,%.2e,%.3f,%.1f,%.4f,%.4f,%.2f,%.4f,%.4f,%.2f,%.4f,%.1e\n", h.x, h.y,
+                   h.z, p.demag.cells(), p.pole_cells(), threads, setup, m.ampere_turns, solve,
                    r.report.newton_iterations, r.report.krylov_iterations, r.report.residual, F, m.force, eF, r.Bz_P1,
                    m.Bz_P1, e1, r.Bz_P2, m.Bz_P2, e2, balance);
-      std::fprintf(md, "| %.3g | %d | %.2f | %.0f | %.3f | %d / %d | %.2f | %.1f | %+.1f%% | %.3f | %+.1f%% | %.3f | %+.1f%% |\n",
-                   h, p.demag.cells(), setup, m.ampere_turns, solve, r.report.newton_iterations,
+      std::fprintf(md, "| %s | %d | %.2f | %.0f | %.3f | %d / %d | %.2f | %.1f | %+.1f%% | %.3f | %+.1f%% | %.3f | %+.1f%% |\n",
+                   hstr.c_str(), p.demag.cells(), setup, m.ampere_turns, solve, r.report.newton_iterations,
                    r.report.krylov_iterations, F, m.force, 100 * eF, r.Bz_P1, 100 * e1, r.Bz_P2, 100 * e2);
-      std::printf("h %.3g mm cells %d AT %.0f: F %.2f N (%+.1f%%) Bz P1 %.3f (%+.1f%%) P2 %.3f (%+.1f%%) solve %.3f s, "
+      std::printf("h %s mm cells %d AT %.0f: F %.2f N (%+.1f%%) Bz P1 %.3f (%+.1f%%) P2 %.3f (%+.1f%%) solve %.3f s, "
                   "%d Newton %d GMRES, residual %.1e, balance %.1e\n",
-                  h, p.demag.cells(), m.ampere_turns, F, 100 * eF, r.Bz_P1, 100 * e1, r.Bz_P2, 100 * e2, solve,
+                  hstr.c_str(), p.demag.cells(), m.ampere_turns, F, 100 * eF, r.Bz_P1, 100 * e1, r.Bz_P2, 100 * e2, solve,
                   r.report.newton_iterations, r.report.krylov_iterations, r.report.residual, balance);
       std::fflush(stdout);
     }

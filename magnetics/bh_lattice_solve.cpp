@@ -124,7 +124,6 @@ BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, 
   }
   double r = residual(H, R);
   report.residuals.push_back(g);
-  const auto& n0 = demag.self_tensor();
   std::vector<Vec3> x3(N), y3(N);
   auto apply = [&](const VectorXd& x, VectorXd& y) {  // (I + N J) x, N v = -H_d(v)
     for (int i = 0; i < N; ++i) x3[i] = symmetric_times(J[i].data(), Vec3{x(3 * i), x(3 * i + 1), x(3 * i + 2)});
@@ -138,9 +137,10 @@ BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, 
   };
   double eta = options.forcing;
   while (g > options.tolerance && report.newton_iterations < options.max_newton) {
-    Eigen::Matrix3d Ni;
-    Ni << n0[0], n0[1], n0[2], n0[1], n0[3], n0[4], n0[2], n0[4], n0[5];
-    for (int i = 0; i < N; ++i) {  // (I + N(0) J_i)^-1
+    for (int i = 0; i < N; ++i) {  // (I + N(0) J_i)^-1, N(0) of the cell's lattice
+      const auto& n0 = demag.self_tensor(demag.lattice_of(i));
+      Eigen::Matrix3d Ni;
+      Ni << n0[0], n0[1], n0[2], n0[1], n0[3], n0[4], n0[2], n0[4], n0[5];
       Eigen::Matrix3d Ji;
       const auto& j = J[i];
       Ji << j[0], j[1], j[2], j[1], j[3], j[4], j[2], j[4], j[5];

@@ -217,18 +217,36 @@ void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)
     }
 }
 
-void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const double d[3], double n[6]) {
+void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const double d[3], double n[6],
+                         double (*dn)[6]) {
   const double sign[3] = {d[0] < 0.0 ? -1.0 : (d[0] > 0.0 ? 1.0 : 0.0), d[1] < 0.0 ? -1.0 : (d[1] > 0.0 ? 1.0 : 0.0),
                           d[2] < 0.0 ? -1.0 : (d[2] > 0.0 ? 1.0 : 0.0)};
   const double X[3] = {std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])};
   double edge = 0.0;
   for (int k = 0; k < 3; ++k) edge = std::max({edge, 2.0 * half_a[k], 2.0 * half_b[k]});
   const double range = kNewellRange * edge;
+  static constexpr int odd[6][3] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, {0, 0, 0}, {0, 1, 1}, {0, 0, 0}};
+  double du[3][6] = {};  // the gradient at |d| (Newell branch)
   if (X[0] * X[0] + X[1] * X[1] + X[2] * X[2] > range * range) {
     double t[6];
     dipole_tensor({X[0], X[1], X[2]}, 0.0, t);  // H = T mu, mu = M V_b, H = -N M
     const double vb = 8.0 * half_b[0] * half_b[1] * half_b[2];
     for (int a = 0; a < 6; ++a) n[a] = -t[a] * vb;
+    if (dn) {
+      // The point dipole's gradient at the signed d, as cube_demag_tensor_at.
+      const Vec3 r{d[0], d[1], d[2]};
+      const DipoleCoefficients c = dipole_coefficients(X[0] * X[0] + X[1] * X[1] + X[2] * X[2], 0.0);
+      static constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+      for (int k = 0; k < 3; ++k)
+        for (int m = 0; m < 6; ++m) {
+          const int a = row[m], b = col[m];
+          double v = c.C * r[k] * r[a] * r[b];
+          if (a == b) v += c.B * r[k];
+          if (a == k) v += c.B * r[b];
+          if (b == k) v += c.B * r[a];
+          dn[k][m] = -vb * v;
+        }
+    }
   } else {
     // Per axis: the four corner differences of the two intervals and their
     // weights (the double integral of a function of x - x' over both
@@ -251,10 +269,22 @@ void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const d
             const int* o = order[m];
             double g[3];
             sum[m] += wt * (is_f[m] ? pt.f(o[0], o[1], o[2], g) : pt.g(o[0], o[1], o[2], g));
+            if (dn)  // every corner difference moves with X_k: d/dX_k is the antiderivative's derivative
+              for (int q = 0; q < 3; ++q) du[o[q]][m] += wt * g[q];
           }
         }
     const double c = 1.0 / (4.0 * kPi * 8.0 * half_a[0] * half_a[1] * half_a[2]);
     for (int m = 0; m < 6; ++m) n[m] = c * sum[m];
+    if (dn)
+      // d/dd_k of a component restored with signs: axis k's sign moves from
+      // the odd components to the even ones (as cube_demag_tensor_at).
+      for (int k = 0; k < 3; ++k)
+        for (int m = 0; m < 6; ++m) {
+          double v = c * du[k][m];
+          for (int j = 0; j < 3; ++j)
+            if ((j == k) != (odd[m][j] != 0)) v *= sign[j];
+          dn[k][m] = v;
+        }
   }
   // Components odd in an axis take its sign (zero offset: they vanish).
   n[1] *= sign[0] * sign[1];

@@ -49,7 +49,12 @@ void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)
 // it is cube_demag_tensor; V_a N_ab = V_b N_ba; N(-d) = N(d); d = 0 and
 // half_a = half_b gives the cuboid's own demagnetising tensor. Beyond
 // kNewellRange times the larger edge of the two: the point dipole V_b D(d).
-void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const double d[3], double n[6]);
+// When dn is not null, also its gradient dn[k][c] = dN_c / dd_k (1/m), from
+// the derivatives of Newell's f and g (every corner difference moves with
+// d_k); odd in d, V_a dN_ab/dd = V_b dN_ba/dd at the same d; at faces that
+// pass through each other the two-sided mean, as cube_demag_tensor_at.
+void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const double d[3], double n[6],
+                         double (*dn)[6] = nullptr);
 
 // The cuboid-cuboid tensors between the cells of a tensor-product grid
 // (graded cells), faces[a] the n_a + 1 face positions along axis a: the

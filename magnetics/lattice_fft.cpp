@@ -70,16 +70,17 @@ void transform_lines(Eigen::FFT<double>& fft, bool inverse, std::vector<Complex>
   }
 }
 
-// The pair tensor at real offset d (target centre - source centre): N (six
-// components) and, when g is not null, its gradient g[k][c] = dN_c / dd_k (cubes only).
-void pair_tensor(const Vec3& cell, const Vec3& d, double n[6], double (*g)[6]) {
+// The pair tensor at real offset d (target centre - source centre) of cells
+// of half extents ht (target) and hs (source): N (six components) and, when g
+// is not null, its gradient g[k][c] = dN_c / dd_k.
+void pair_tensor(const Vec3& ht, const Vec3& hs, const Vec3& d, double n[6], double (*g)[6]) {
   const double dd[3] = {d.x, d.y, d.z};
-  if (g) {
-    cube_demag_tensor_at(dd, cell.x, n, g);
+  const double a[3] = {ht.x, ht.y, ht.z}, b[3] = {hs.x, hs.y, hs.z};
+  if (g && ht.x == hs.x && ht.y == hs.y && ht.z == hs.z && ht.x == ht.y && ht.y == ht.z) {
+    cube_demag_tensor_at(dd, 2.0 * ht.x, n, g);  // equal cubes
     return;
   }
-  const double half[3] = {0.5 * cell.x, 0.5 * cell.y, 0.5 * cell.z};
-  cuboid_demag_tensor(half, half, dd, n);
+  cuboid_demag_tensor(a, b, dd, n, g);
 }
 
 }  // namespace
@@ -88,8 +89,6 @@ LatticeDemag::LatticeDemag(const Vec3& cell, std::vector<LatticeGrid> lattices,
                            const std::vector<std::array<int, 2>>& force_pairs)
     : cell_(cell), lattices_(std::move(lattices)), force_pairs_(force_pairs) {
   if (!(cell.x > 0.0 && cell.y > 0.0 && cell.z > 0.0)) throw std::invalid_argument("LatticeDemag: cell size must be positive");
-  const bool cubic = cell.x == cell.y && cell.y == cell.z;
-  if (!force_pairs_.empty() && !cubic) throw std::invalid_argument("LatticeDemag: forces need cubic cells");
   const int L = static_cast<int>(lattices_.size());
   std::array<int, 3> largest{1, 1, 1};
   first_.push_back(0);
@@ -97,6 +96,14 @@ LatticeDemag::LatticeDemag(const Vec3& cell, std::vector<LatticeGrid> lattices,
     const auto& g = lattices_[l];
     if (g.mask.size() != static_cast<size_t>(g.n[0]) * g.n[1] * g.n[2])
       throw std::invalid_argument("LatticeDemag: mask size differs from the lattice's cell count");
+    const Vec3 e = g.extent.x == 0.0 && g.extent.y == 0.0 && g.extent.z == 0.0 ? cell_ : g.extent;
+    for (int a = 0; a < 3; ++a)
+      if (!(e[a] > 0.0) || (g.n[a] > 1 && e[a] > cell_[a]))
+        throw std::invalid_argument("LatticeDemag: a cell's extent must be positive and, along an axis with more than one cell, at most the spacing");
+    half_.push_back(0.5 * e);
+    volume_.push_back(e.x * e.y * e.z);
+    self_of_.emplace_back();
+    pair_tensor(half_.back(), half_.back(), Vec3{}, self_of_.back().data(), nullptr);
     for (int k = 0; k < g.n[2]; ++k)
       for (int j = 0; j < g.n[1]; ++j)
         for (int i = 0; i < g.n[0]; ++i)
@@ -107,7 +114,7 @@ LatticeDemag::LatticeDemag(const Vec3& cell, std::vector<LatticeGrid> lattices,
   for (int a = 0; a < 3; ++a) pad_[a] = padded_size(2 * largest[a] - 1);  // no wrap-around: P >= n_t + n_s - 1
   half_x_ = pad_[0] / 2 + 1;
   const Vec3 zero{0.0, 0.0, 0.0};
-  pair_tensor(cell_, zero, self_.data(), nullptr);
+  pair_tensor(0.5 * cell_, 0.5 * cell_, zero, self_.data(), nullptr);
 
   // Kernel grids: entry d mod P holds the tensor at offset (origin_t - origin_s) + d h,
   // d_a from -(n_s - 1) to n_t - 1.
@@ -126,7 +133,7 @@ LatticeDemag::LatticeDemag(const Vec3& cell, std::vector<LatticeGrid> lattices,
                         pad_[0] * (static_cast<size_t>((d[1] + pad_[1]) % pad_[1]) +
                                    pad_[1] * static_cast<size_t>((d[2] + pad_[2]) % pad_[2]));
       double n[6], g[3][6];
-      pair_tensor(cell_, offset(t, s, d), n, gradient ? g : nullptr);
+      pair_tensor(half_[t], half_[s], offset(t, s, d), n, gradient ? g : nullptr);
       if (!gradient) {
         for (int c = 0; c < 6; ++c) grids[c][at] = n[c];
       } else {
@@ -136,8 +143,9 @@ LatticeDemag::LatticeDemag(const Vec3& cell, std::vector<LatticeGrid> lattices,
     }
   };
   const std::array<int, 3> full = pad_;
-  // Pairs t <= s only: the kernel of (s, t) is that of (t, s) at -d (N(-d) =
-  // N(d)), whose spectrum is the complex conjugate.
+  // Pairs t <= s only: the kernel of (s, t) is that of (t, s) at -d times
+  // V_t / V_s (N_st(-d) = N_ts(d) V_t / V_s, N even in d), whose spectrum is
+  // the complex conjugate.
   kernel_.resize(static_cast<size_t>(L) * L);
   std::vector<std::vector<double>> grids;
   for (int t = 0; t < L; ++t)
@@ -158,6 +166,8 @@ Vec3 LatticeDemag::offset(int target, int source, const std::array<int, 3>& d) c
   const Vec3 o = lattices_[target].origin - lattices_[source].origin;
   return {o.x + d[0] * cell_.x, o.y + d[1] * cell_.y, o.z + d[2] * cell_.z};
 }
+
+int LatticeDemag::lattice_of(int cell) const { return cell_index_[cell][0]; }
 
 Vec3 LatticeDemag::centre(int cell) const {
   const auto& c = cell_index_[cell];
@@ -243,10 +253,14 @@ void LatticeDemag::field(const std::vector<Vec3>& M, std::vector<Vec3>& H) const
       const bool mirrored = s < t;
       const auto& K = kernel_[mirrored ? s * L + t : t * L + s];
       const auto &m0 = m[s][0], &m1 = m[s][1], &m2 = m[s][2];
+      const double ratio = volume_[s] / volume_[t];  // reciprocity V_t N_ts = V_s N_st
+      const bool scaled = mirrored && ratio != 1.0;
 #pragma omp parallel for if (parallel())
       for (long q = 0; q < static_cast<long>(S); ++q) {
         Complex n[6];
         for (int c = 0; c < 6; ++c) n[c] = mirrored ? std::conj(K[c][q]) : K[c][q];
+        if (scaled)
+          for (auto& v : n) v *= ratio;
         h[0][q] -= multiply_add3(n[0], m0[q], n[1], m1[q], n[2], m2[q]);
         h[1][q] -= multiply_add3(n[1], m0[q], n[3], m1[q], n[4], m2[q]);
         h[2][q] -= multiply_add3(n[2], m0[q], n[4], m1[q], n[5], m2[q]);
@@ -274,7 +288,7 @@ Vec3 LatticeDemag::force(int target, int source, const std::vector<Vec3>& M) con
   Spectrum q;
   std::vector<double> grid;
   Vec3 F{};
-  const double V = cell_.x * cell_.y * cell_.z;
+  const double V = volume_[target];
   // (2): Q_ka = sum_j dN_kb/dd_a M_jb (symmetric in k, a), F_a = -mu0 V sum_i M_ik Q_ka.
   for (int k = 0; k < 3; ++k)
     for (int a = k; a < 3; ++a) {
@@ -301,7 +315,7 @@ void LatticeDemag::dense_field(const std::vector<Vec3>& M, std::vector<Vec3>& H)
     const Vec3 ri = centre(i);
     for (int j = 0; j < cells(); ++j) {
       double n[6];
-      pair_tensor(cell_, ri - centre(j), n, nullptr);
+      pair_tensor(half_[lattice_of(i)], half_[lattice_of(j)], ri - centre(j), n, nullptr);
       H[i] -= symmetric_times(n, M[j]);  // (1)
     }
   }
@@ -309,11 +323,11 @@ void LatticeDemag::dense_field(const std::vector<Vec3>& M, std::vector<Vec3>& H)
 
 Vec3 LatticeDemag::dense_force(int target, int source, const std::vector<Vec3>& M) const {
   Vec3 F{};
-  const double V = cell_.x * cell_.y * cell_.z;
+  const double V = volume_[target];
   for (int i = first_[target]; i < first_[target + 1]; ++i)
     for (int j = first_[source]; j < first_[source + 1]; ++j) {
       double n[6], g[3][6];
-      pair_tensor(cell_, centre(i) - centre(j), n, g);
+      pair_tensor(half_[target], half_[source], centre(i) - centre(j), n, g);
       for (int a = 0; a < 3; ++a) F[a] -= kMu0 * V * dot(M[i], symmetric_times(g[a], M[j]));  // (2)
     }
   return F;

@@ -1,11 +1,12 @@
 // The demagnetizing field of lattice bodies by FFT convolution
 // (docs/model.md "FFT convolution on lattices").
 //
-// Cells are uniformly magnetized cuboids of one size (hx, hy, hz), axis
-// aligned, on regular lattices: lattice l has n[l] cells per axis with cell
+// Cells are uniformly magnetized cuboids, axis aligned, on regular lattices
+// of one spacing (hx, hy, hz): lattice l has n[l] cells per axis with cell
 // (i, j, k) centred at origin + (i hx, j hy, k hz); the cells of a body are a
-// mask on its lattice. Lattices share the cell size and the orientation but
-// their origins differ arbitrarily (not by multiples of h). The mean field over
+// mask on its lattice; a cell's edges are the spacing unless the lattice
+// says otherwise (layers, below). Lattices share the spacing and the
+// orientation but their origins differ arbitrarily (not by multiples of h). The mean field over
 // cell i of lattice t is
 //   H_i = -sum_s sum_j N(r_i - r_j) M_j                                  (1)
 // with N the cell-averaged cuboid-cuboid tensor (cuboid_demag_tensor, the
@@ -17,12 +18,21 @@
 // 3 inverse FFTs per target lattice (real-to-complex along x, and the
 // transforms pruned to the lines that hold data).
 //
-// The force on the cells of lattice t from those of lattice s, for cubic
-// cells (edge h):
-//   F = mu0 V sum_i M_i . grad (M_i . H_i^(s)) = -mu0 V sum_ij M_i^T dN/dd (r_i - r_j) M_j   (2)
-// exact for uniformly magnetized cubes (the mean of (M . grad) H over cube i
-// is the derivative of its mean field by translation); dN/dd from
-// cube_demag_tensor_at, is odd in d, so F_ts = -F_st to round-off.
+// A lattice's cells may be smaller than its spacing (LatticeGrid::extent):
+// along an axis with one cell any extent, so that a layer of cells one cell
+// thick fits a body's face between the spacing's planes (cells that straddle
+// no face: every cell all steel). The pair tensor is then that of unequal
+// cuboids (cuboid_demag_tensor), still a function of i - j on each pair, and
+// (1) keeps its convolution; V_t N_ts(d) = V_s N_st(-d) gives (s, t)'s kernel
+// from (t, s)'s.
+//
+// The force on the cells of lattice t from those of lattice s:
+//   F = mu0 V_t sum_i M_i . grad (M_i . H_i^(s)) = -mu0 V_t sum_ij M_i^T dN_ts/dd (r_i - r_j) M_j   (2)
+// exact for uniformly magnetized cuboids (the mean of (M . grad) H over cell
+// i is the derivative of its mean field by translation, curl H = 0 outside
+// lattice s); dN/dd from cube_demag_tensor_at (equal cubes) or
+// cuboid_demag_tensor, is odd in d with V_t dN_ts/dd = V_s dN_st/dd, so F_ts =
+// -F_st to round-off.
 #pragma once
 
 #include <array>
@@ -37,12 +47,16 @@ struct LatticeGrid {
   Vec3 origin;                      // centre of cell (0, 0, 0), m
   std::array<int, 3> n{0, 0, 0};    // cells per axis
   std::vector<char> mask;           // n0 n1 n2 entries, x fastest: 1 where the body has a cell
+  // The cells' edges, m; zero: the spacing (LatticeDemag's cell). At most
+  // the spacing along an axis with more than one cell.
+  Vec3 extent{0.0, 0.0, 0.0};
 };
 
 class LatticeDemag {
  public:
-  // cell: the edges (hx, hy, hz), m. force_pairs: the (target, source)
-  // lattice pairs whose force (2) is wanted (cubic cells only).
+  // cell: the spacing (hx, hy, hz) of every lattice, m, and the edges of
+  // its cells unless LatticeGrid::extent says otherwise. force_pairs: the
+  // (target, source) lattice pairs whose force (2) is wanted.
   LatticeDemag(const Vec3& cell, std::vector<LatticeGrid> lattices,
                const std::vector<std::array<int, 2>>& force_pairs = {});
 
@@ -51,7 +65,11 @@ class LatticeDemag {
   int cells_of(int lattice) const { return first_[lattice + 1] - first_[lattice]; }
   int first_cell(int lattice) const { return first_[lattice]; }
   Vec3 centre(int cell) const;
+  int lattice_of(int cell) const;
   const Vec3& cell_size() const { return cell_; }
+  // A lattice's cell edges (m) and volume (m^3).
+  Vec3 extent(int lattice) const { return 2.0 * half_[lattice]; }
+  double volume(int lattice) const { return volume_[lattice]; }
   int lattice_count() const { return static_cast<int>(lattices_.size()); }
 
   // (1): H (size cells()) from M (size cells()), A/m.
@@ -60,6 +78,8 @@ class LatticeDemag {
   Vec3 force(int target, int source, const std::vector<Vec3>& M) const;
   // The self tensor N(0) of a cell (six components xx, xy, xz, yy, yz, zz).
   const std::array<double, 6>& self_tensor() const { return self_; }
+  // The self tensor of a lattice's cells (its extent's).
+  const std::array<double, 6>& self_tensor(int lattice) const { return self_of_[lattice]; }
 
   // The same sums pair by pair (O(N^2)), the reference the FFT is checked against.
   void dense_field(const std::vector<Vec3>& M, std::vector<Vec3>& H) const;
@@ -86,6 +106,9 @@ class LatticeDemag {
   std::vector<std::array<int, 2>> force_pairs_;
   std::vector<std::array<Spectrum, 10>> gradient_;  // per force pair: spectra of dN_ij/dd_k (symmetric, 10)
   std::array<double, 6> self_{};
+  std::vector<Vec3> half_;                      // per lattice: the cells' half edges
+  std::vector<double> volume_;                  // per lattice: a cell's volume
+  std::vector<std::array<double, 6>> self_of_;  // per lattice: N(0) of its cells
 };
 
 }  // namespace odemag

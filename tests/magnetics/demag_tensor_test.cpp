@@ -312,6 +312,52 @@ TEST(CuboidDemagTensor, MatchesQuadratureAndThePointDipole) {
   }
 }
 
+// The gradient of the unequal-cuboid tensor (cuboid_demag_tensor's dn, the
+// lattice force's dN/dd): against central differences of the tensor (itself
+// checked against quadrature above), near (overlapping projections, faces
+// apart) and far (point dipole); odd in d; V_a dN_ab = V_b dN_ba; for equal
+// cubes it is cube_demag_tensor_at's.
+TEST(CuboidDemagTensor, GradientMatchesCentralDifferencesAndIsReciprocal) {
+  const double a[3] = {0.3e-3, 0.5e-3, 0.2e-3}, b[3] = {0.7e-3, 0.25e-3, 0.4e-3};
+  const double va = 8 * a[0] * a[1] * a[2], vb = 8 * b[0] * b[1] * b[2];
+  for (const auto& d : std::vector<std::array<double, 3>>{{1.3e-3, 0.2e-3, 0.1e-3},
+                                                          {0.3e-3, 0.9e-3, -0.15e-3},
+                                                          {-0.2e-3, 0.1e-3, 0.75e-3},
+                                                          {2e-3, -1e-3, 3e-3},
+                                                          {30e-3, 12e-3, -9e-3}}) {
+    double n[6], g[3][6], gba[3][6], gneg[3][6], unused[6];
+    cuboid_demag_tensor(a, b, d.data(), n, g);
+    const double md[3] = {-d[0], -d[1], -d[2]};
+    cuboid_demag_tensor(b, a, d.data(), unused, gba);
+    cuboid_demag_tensor(a, b, md, unused, gneg);
+    double scale = 0.0;
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 6; ++c) scale = std::max(scale, std::fabs(g[k][c]));
+    ASSERT_GT(scale, 0.0);
+    for (int k = 0; k < 3; ++k) {
+      const double step = 1e-6 * std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      double p[3] = {d[0], d[1], d[2]}, m[3] = {d[0], d[1], d[2]}, np[6], nm[6];
+      p[k] += step, m[k] -= step;
+      cuboid_demag_tensor(a, b, p, np);
+      cuboid_demag_tensor(a, b, m, nm);
+      for (int c = 0; c < 6; ++c) {
+        // The difference quotient's round-off: the 64-term sums cancel digits a few edges apart.
+        EXPECT_NEAR(g[k][c], (np[c] - nm[c]) / (2 * step), 1e-5 * scale) << d[0] << " " << k << " " << c;
+        EXPECT_NEAR(g[k][c], -gneg[k][c], 1e-12 * scale) << k << " " << c;
+        EXPECT_NEAR(va * g[k][c], vb * gba[k][c], 1e-10 * va * scale) << k << " " << c;
+      }
+    }
+  }
+  const double h = 1e-3, half[3] = {0.5e-3, 0.5e-3, 0.5e-3};
+  for (const auto& d : std::vector<std::array<double, 3>>{{1.2e-3, 0.3e-3, -0.4e-3}, {0.0, 2e-3, 1e-3}}) {
+    double n[6], g[3][6], nc[6], gc[3][6];
+    cuboid_demag_tensor(half, half, d.data(), n, g);
+    cube_demag_tensor_at(d.data(), h, nc, gc);
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 6; ++c) EXPECT_NEAR(g[k][c], gc[k][c], 1e-12 / h) << k << " " << c;
+  }
+}
+
 // The tabulated grid tensors (GridDemagTable, used for graded bodies) give
 // cuboid_demag_tensor of the two cells, near and far (point dipole), on an
 // uneven grid.

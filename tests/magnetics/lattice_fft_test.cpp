@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include "magnetics/bh_lattice_solve.h"
 #include "magnetics/constants.h"
@@ -68,6 +69,39 @@ TEST(LatticeFft, ForceEqualsTheDenseSumAndBalances) {
   const Vec3 dense = demag.dense_force(0, 1, M);
   EXPECT_LT(norm(F01 - dense), 1e-11 * norm(dense));
   EXPECT_LT(norm(F01 + F10), 1e-11 * norm(F01));  // momentum balance F_01 = -F_10
+}
+
+// Cells smaller than the spacing (LatticeGrid::extent): a layer one cell
+// thick in z of flat cells and one in x of thin cells next to a lattice of
+// cuboids, all at non-integer offsets. The FFT field (unequal-cuboid kernels,
+// the (s, t) kernel by reciprocity) and the forces equal the dense sums, and
+// the forces balance.
+TEST(LatticeFft, LayersOfSmallerCellsEqualTheDenseSums) {
+  const Vec3 cell{1e-3, 0.8e-3, 1.2e-3};
+  LatticeGrid flat = random_lattice({0.2e-3, -0.55e-3, 4.1e-3}, {4, 5, 1}, 3);
+  flat.extent = {1e-3, 0.8e-3, 0.35e-3};
+  LatticeGrid thin = random_lattice({5.3e-3, 0.4e-3, 0.7e-3}, {1, 4, 3}, 4);
+  thin.extent = {0.25e-3, 0.6e-3, 1.2e-3};
+  const std::vector<LatticeGrid> g{random_lattice({0.0, 0.0, 0.0}, {5, 4, 3}, 1), flat, thin};
+  const LatticeDemag demag(cell, g, {{0, 1}, {1, 0}, {1, 2}, {2, 1}, {0, 2}, {2, 0}});
+  for (int l = 0; l < 3; ++l) ASSERT_GT(demag.cells_of(l), 5);
+  EXPECT_NEAR(demag.volume(1), 1e-3 * 0.8e-3 * 0.35e-3, 1e-24);
+  const auto M = random_magnetization(demag.cells(), 1e6);
+  std::vector<Vec3> fft, dense;
+  demag.field(M, fft);
+  demag.dense_field(M, dense);
+  EXPECT_LT(max_relative_difference(fft, dense), 1e-12);
+  for (const auto& p : std::vector<std::array<int, 2>>{{0, 1}, {1, 2}, {0, 2}}) {
+    const Vec3 F = demag.force(p[0], p[1], M), back = demag.force(p[1], p[0], M);
+    const Vec3 ref = demag.dense_force(p[0], p[1], M);
+    // 1e-10: the unequal cuboids' 64-term sums cancel more digits than the cubes' 27.
+    EXPECT_LT(norm(F - ref), 1e-10 * norm(ref)) << p[0] << p[1];
+    EXPECT_LT(norm(F + back), 1e-10 * norm(F)) << p[0] << p[1];  // momentum balance
+  }
+  // A cell larger than the spacing along an axis with several cells would overlap its neighbours.
+  LatticeGrid bad = random_lattice({0.0, 0.0, 9e-3}, {2, 2, 2}, 5);
+  bad.extent = {1e-3, 0.8e-3, 1.5e-3};
+  EXPECT_THROW(LatticeDemag(cell, {bad}), std::invalid_argument);
 }
 
 // One soft cube of 4^3 cells in a uniform field: the solve converges, and the

@@ -16,16 +16,19 @@
 // 39 (corner radius 5), 26.7 <= z <= 123.3, uniform current density. Gap
 // probes P1 = (0, 0, 25.75), P2 = (12.5, 5, 25.75).
 //
-// Discretization (the rule, docs/validation.md "TEAM 20"): cubic cells of
-// edge h (25 / h and 2.5 / h integers) on four lattices with arbitrary
+// Discretization (the rule, docs/validation.md "TEAM 20"): every cell is
+// all steel (no cut cells: a cut cell is a full cuboid of weaker M whose
+// charge sits in the air beside the steel, in series with the gaps' flux).
+// Cubes of edge h (25 / h and 10 / h integers) on lattices with arbitrary
 // offsets: the pole's from its corner (-12.5, -5, 26.5), exact in its
-// cross-section and the 1.5 mm gap, its top cell cut at z = 125; each column
-// with its top bar from the yoke's outer face (x = -63.5 and 13.5, z = 25):
-// exact, the 1 mm between pole and top bars included; the bottom bar centred
-// on x = 0, exact in y and z, its 127 mm length in ceil(127 / h) cells with
-// the end cells cut. A cell's volume share of steel w (the overlap of the cell
-// with the body's boxes over h^3) is its mean magnetization's weight
-// (bh_lattice_solve.h (3)).
+// cross-section and the 1.5 mm gap, up to the last whole cube below z = 125,
+// and a layer of flat cells (h, h, t) up to z = 125 (t = 98.5 mm mod h);
+// the bottom bar's centred on x = 0 (cell faces on the pole's faces x =
+// +-12.5), exact in y and z, its whole cubes within |x| <= 63.5 and at each
+// end a layer of thin cells (t, h, h) (t = 51 mm mod h); each column with its
+// top bar from the yoke's outer face (x = -63.5 and 13.5, z = 25): exact, the
+// 1 mm between pole and top bars included. The layers are lattices of their
+// own whose cells are smaller than the spacing (LatticeGrid::extent).
 #pragma once
 
 #include <algorithm>
@@ -92,67 +95,83 @@ inline RoundedRectangleCoil coil(double ampere_turns) {
 
 inline const Vec3 kP1{0.0, 0.0, 25.75 * kMm}, kP2{12.5 * kMm, 5 * kMm, 25.75 * kMm};
 
-// Lattice of cubes of edge h with cell (0, 0, 0) spanning [corner, corner + h]
-// and n cells per axis; each cell's volume share of the boxes.
-inline LatticeGrid box_lattice(const Vec3& corner, double h, const std::array<int, 3>& n,
-                               const std::vector<Box>& boxes, std::vector<double>& share) {
+// Lattice of cells of edges e (spacing h per axis) with cell (0, 0, 0)
+// spanning [corner, corner + e] and n cells per axis; a cell where it lies
+// inside the boxes (every cell all steel or none, by the rule above).
+inline LatticeGrid box_lattice(const Vec3& corner, const Vec3& h, const std::array<int, 3>& n,
+                               const std::vector<Box>& boxes, const Vec3& e) {
   LatticeGrid g;
-  g.origin = corner + Vec3{0.5 * h, 0.5 * h, 0.5 * h};
+  g.origin = corner + 0.5 * e;
   g.n = n;
+  g.extent = e;
   g.mask.assign(static_cast<size_t>(n[0]) * n[1] * n[2], 0);
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
       for (int i = 0; i < n[0]; ++i) {
-        const Vec3 lo = corner + Vec3{i * h, j * h, k * h};
-        double w = 0.0;
-        for (const Box& b : boxes) {
-          double v = 1.0;
-          for (int a = 0; a < 3; ++a) v *= std::max(0.0, std::min(lo[a] + h, b.hi[a]) - std::max(lo[a], b.lo[a])) / h;
-          w += v;
-        }
-        if (w > 1e-9) {  // slivers below 1e-9 of a cell (round-off at shared faces) are not cells
-          g.mask[i + static_cast<size_t>(n[0]) * (j + static_cast<size_t>(n[1]) * k)] = 1;
-          share.push_back(std::min(w, 1.0));
-        }
+        const Vec3 c = g.origin + Vec3{i * h.x, j * h.y, k * h.z};
+        for (const Box& b : boxes)
+          if (c.x > b.lo.x && c.x < b.hi.x && c.y > b.lo.y && c.y < b.hi.y && c.z > b.lo.z && c.z < b.hi.z)
+            g.mask[i + static_cast<size_t>(n[0]) * (j + static_cast<size_t>(n[1]) * k)] = 1;
       }
   return g;
 }
 
-// The discretized problem at cell edge h (mm; 25 / h and 2.5 / h integers).
+// The discretized problem at cell edges h = (hx, hy, hz) (mm; 25 / hx,
+// 10 / hy, 25 / hy and 25 / hz integers): cubes, or cuboids coarser along z.
 struct Problem {
-  double h = 0.0;  // m
+  Vec3 h;  // m
   bool balance = false;
-  std::vector<double> fill;          // volume share per cell (pole cells first)
   std::vector<Vec3> coil_H;          // coil field at 1 A-turn at the cell centres, A/m
   std::vector<std::array<Vec3, 3>> coil_gradient;  // pole cells: d(coil_H)/dx_a (row a), 1 A-turn
+  int pole_lattices = 0;  // set by make (declared before demag, which is built by it)
   LatticeDemag demag;
   BhCurve curve{bh_table()};
 
-  // Lattices: 0 the pole, 1 the bottom bar, 2 and 3 the left and right
-  // column with its top bar (x faces on the yoke's outer face).
-  static LatticeDemag make(double h, std::vector<double>& fill, bool balance) {
-    auto cells = [h](double length_mm) { return static_cast<int>(std::ceil(length_mm * kMm / h - 1e-9)); };
+  // Lattices: the pole's (its cells, then its top layer when hz does not
+  // divide 98.5 mm), then the yoke's: the bottom bar's cells, its end layers
+  // (when hx does not divide 51 mm), the left and right column with its top bar.
+  static LatticeDemag make(const Vec3& h, bool balance, int& pole_lattices) {
+    auto whole = [](double length_mm, double edge) {
+      return static_cast<int>(std::floor((length_mm * kMm + 1e-9 * edge) / edge));
+    };
     const auto yoke = yoke_boxes();
-    const std::vector<Box> bar{yoke[0]}, left{yoke[1], yoke[3]}, right{yoke[2], yoke[4]};
-    const int bar_x = cells(127.0), side_x = cells(50.0), side_z = cells(125.0), y = cells(25.0);
+    const std::vector<Box> pole = pole_boxes(), bar{yoke[0]}, left{yoke[1], yoke[3]}, right{yoke[2], yoke[4]};
+    const int px = whole(25.0, h.x), py = whole(10.0, h.y), pz = whole(98.5, h.z), y = whole(25.0, h.y);
+    const int bar_z = whole(25.0, h.z), side_x = whole(50.0, h.x), side_z = whole(125.0, h.z);
     std::vector<LatticeGrid> g;
-    g.push_back(box_lattice({-12.5 * kMm, -5 * kMm, 26.5 * kMm}, h, {cells(25.0), cells(10.0), cells(98.5)}, pole_boxes(), fill));
-    g.push_back(box_lattice({-0.5 * bar_x * h, -12.5 * kMm, 0.0}, h, {bar_x, y, cells(25.0)}, bar, fill));
-    g.push_back(box_lattice({-63.5 * kMm, -12.5 * kMm, 25 * kMm}, h, {side_x, y, side_z}, left, fill));
-    g.push_back(box_lattice({13.5 * kMm, -12.5 * kMm, 25 * kMm}, h, {side_x, y, side_z}, right, fill));
-    std::vector<std::array<int, 2>> pairs{{0, 1}, {0, 2}, {0, 3}};
-    if (balance) pairs.insert(pairs.end(), {{1, 0}, {2, 0}, {3, 0}});
-    return LatticeDemag({h, h, h}, g, pairs);
+    g.push_back(box_lattice({-12.5 * kMm, -5 * kMm, 26.5 * kMm}, h, {px, py, pz}, pole, h));
+    const double top = 98.5 * kMm - pz * h.z;  // the pole's top layer
+    if (top > 1e-9 * h.z)
+      g.push_back(box_lattice({-12.5 * kMm, -5 * kMm, 125 * kMm - top}, h, {px, py, 1}, pole, {h.x, h.y, top}));
+    pole_lattices = static_cast<int>(g.size());
+    const int k = whole(51.0, h.x);
+    const double reach = 12.5 * kMm + k * h.x, end = 63.5 * kMm - reach;  // the bar's cells reach |x| = reach
+    g.push_back(box_lattice({-reach, -12.5 * kMm, 0.0}, h, {2 * k + px, y, bar_z}, bar, h));
+    if (end > 1e-9 * h.x) {
+      g.push_back(box_lattice({-63.5 * kMm, -12.5 * kMm, 0.0}, h, {1, y, bar_z}, bar, {end, h.y, h.z}));
+      g.push_back(box_lattice({reach, -12.5 * kMm, 0.0}, h, {1, y, bar_z}, bar, {end, h.y, h.z}));
+    }
+    g.push_back(box_lattice({-63.5 * kMm, -12.5 * kMm, 25 * kMm}, h, {side_x, y, side_z}, left, h));
+    g.push_back(box_lattice({13.5 * kMm, -12.5 * kMm, 25 * kMm}, h, {side_x, y, side_z}, right, h));
+    std::vector<std::array<int, 2>> pairs;
+    for (int t = 0; t < pole_lattices; ++t)
+      for (int s = pole_lattices; s < static_cast<int>(g.size()); ++s) {
+        pairs.push_back({t, s});
+        if (balance) pairs.push_back({s, t});
+      }
+    return LatticeDemag(h, g, pairs);
   }
 
+  int pole_cells() const { return demag.first_cell(pole_lattices); }
+
   // balance: also the forces on the yoke from the pole (the momentum check).
-  explicit Problem(double h_mm, bool with_balance = false)
-      : h(h_mm * kMm), balance(with_balance), demag(make(h, fill, with_balance)) {
+  explicit Problem(const Vec3& h_mm, bool with_balance = false)
+      : h(kMm * h_mm), balance(with_balance), demag(make(h, with_balance, pole_lattices)) {
     const RoundedRectangleCoil unit = coil(1.0);
-    const int N = demag.cells(), pole = demag.cells_of(0);
+    const int N = demag.cells(), pole = pole_cells();
     coil_H.resize(N);
     coil_gradient.resize(pole);
-    const double d = 1e-2 * h;  // central differences of the smooth coil field (the pole is 7 mm from the copper)
+    const double d = 1e-2 * std::min({h.x, h.y, h.z});  // central differences of the smooth coil field (the pole is 7 mm from the copper)
 #pragma omp parallel for schedule(dynamic, 8)
     for (int i = 0; i < N; ++i) {
       const Vec3 c = demag.centre(i);
@@ -165,6 +184,7 @@ struct Problem {
         }
     }
   }
+  explicit Problem(double h_mm, bool with_balance = false) : Problem(Vec3{h_mm, h_mm, h_mm}, with_balance) {}
 };
 
 struct Result {
@@ -178,8 +198,8 @@ struct Result {
 // B (T) at a point outside the steel: the coil's and every cell's field.
 inline Vec3 flux_density(const Problem& p, const std::vector<Vec3>& M, double ampere_turns, const Vec3& point) {
   Vec3 H = coil_field_H(coil(ampere_turns), point);
-  const Vec3 half{0.5 * p.h, 0.5 * p.h, 0.5 * p.h};
-  for (int i = 0; i < p.demag.cells(); ++i) H += uniform_cuboid_field(point - p.demag.centre(i), half, M[i]);
+  for (int i = 0; i < p.demag.cells(); ++i)
+    H += uniform_cuboid_field(point - p.demag.centre(i), 0.5 * p.demag.extent(p.demag.lattice_of(i)), M[i]);
   return kMu0 * H;
 }
 
@@ -188,14 +208,18 @@ inline Result solve(const Problem& p, double ampere_turns, std::vector<Vec3>& M,
   std::vector<Vec3> source(p.coil_H.size());
   for (size_t i = 0; i < source.size(); ++i) source[i] = ampere_turns * p.coil_H[i];
   Result r;
-  r.report = solve_bh_lattice(p.demag, p.curve, p.fill, source, M, options);
-  for (int s = 1; s < p.demag.lattice_count(); ++s) r.force_from_yoke += p.demag.force(0, s, M);
-  if (p.balance)
-    for (int s = 1; s < p.demag.lattice_count(); ++s) r.force_on_yoke += p.demag.force(s, 0, M);
+  const std::vector<double> fill(p.coil_H.size(), 1.0);  // every cell all steel
+  r.report = solve_bh_lattice(p.demag, p.curve, fill, source, M, options);
+  for (int t = 0; t < p.pole_lattices; ++t)
+    for (int s = p.pole_lattices; s < p.demag.lattice_count(); ++s) {
+      r.force_from_yoke += p.demag.force(t, s, M);
+      if (p.balance) r.force_on_yoke += p.demag.force(s, t, M);
+    }
   // The coil's part, mu0 V sum (M . grad) H_coil at the pole's cell centres.
   Vec3 coil_force{};
-  for (int i = 0; i < p.demag.cells_of(0); ++i)
-    for (int a = 0; a < 3; ++a) coil_force += (kMu0 * p.h * p.h * p.h * ampere_turns * M[i][a]) * p.coil_gradient[i][a];
+  for (int i = 0; i < p.pole_cells(); ++i)
+    for (int a = 0; a < 3; ++a)
+      coil_force += (kMu0 * p.demag.volume(p.demag.lattice_of(i)) * ampere_turns * M[i][a]) * p.coil_gradient[i][a];
   r.force_pole = r.force_from_yoke + coil_force;
   r.Bz_P1 = flux_density(p, M, ampere_turns, kP1).z;
   r.Bz_P2 = flux_density(p, M, ampere_turns, kP2).z;
