@@ -10,6 +10,28 @@ namespace odemag {
 
 namespace {
 
+// Far away a cell-averaged tensor is the point dipole's: N = -V T(d) with V
+// the source cell's volume (H = T mu, mu = M V, H = -N M), and its gradient
+// from T = A I + B d d^T, dT_ab/dd_k = B (d_k delta_ab + delta_ak d_b +
+// delta_bk d_a) + C d_k d_a d_b (magnetics/kernels.h); r2 = |d|^2.
+void point_dipole_demag(const Vec3& d, double r2, double volume, double n[6], double (*dn)[6]) {
+  double t[6];
+  dipole_tensor(d, 0.0, t);
+  for (int a = 0; a < 6; ++a) n[a] = -t[a] * volume;
+  if (!dn) return;
+  const DipoleCoefficients c = dipole_coefficients(r2, 0.0);
+  static constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+  for (int k = 0; k < 3; ++k)
+    for (int m = 0; m < 6; ++m) {
+      const int a = row[m], b = col[m];
+      double v = c.C * d[k] * d[a] * d[b];
+      if (a == b) v += c.B * d[k];
+      if (a == k) v += c.B * d[b];
+      if (b == k) v += c.B * d[a];
+      dn[k][m] = -volume * v;
+    }
+}
+
 // Newell's f(x, y, z): the sixfold antiderivative behind N_xx (even in each argument).
 double newell_f(double x, double y, double z) {
   x = std::fabs(x), y = std::fabs(y), z = std::fabs(z);
@@ -153,26 +175,7 @@ void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)
   const double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
   const double range = kNewellRange * h;
   if (r2 > range * range) {
-    // Point dipole: n = -h^3 T(d), T = A I + B d d^T, dT_ab/dd_k = B (d_k delta_ab
-    // + delta_ak d_b + delta_bk d_a) + C d_k d_a d_b (magnetics/kernels.h).
-    const Vec3 r{d[0], d[1], d[2]};
-    double t[6];
-    dipole_tensor(r, 0.0, t);
-    const double h3 = h * h * h;
-    for (int a = 0; a < 6; ++a) n[a] = -t[a] * h3;
-    if (dn) {
-      const DipoleCoefficients c = dipole_coefficients(r2, 0.0);
-      static constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
-      for (int k = 0; k < 3; ++k)
-        for (int m = 0; m < 6; ++m) {
-          const int a = row[m], b = col[m];
-          double v = c.C * d[k] * d[a] * d[b];
-          if (a == b) v += c.B * d[k];
-          if (a == k) v += c.B * d[b];
-          if (b == k) v += c.B * d[a];
-          dn[k][m] = -h3 * v;
-        }
-    }
+    point_dipole_demag(Vec3{d[0], d[1], d[2]}, r2, h * h * h, n, dn);
     return;
   }
   // As cube_demag_tensor: the 27-point second differences at |d|, then the
@@ -228,25 +231,10 @@ void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const d
   static constexpr int odd[6][3] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, {0, 0, 0}, {0, 1, 1}, {0, 0, 0}};
   double du[3][6] = {};  // the gradient at |d| (Newell branch)
   if (X[0] * X[0] + X[1] * X[1] + X[2] * X[2] > range * range) {
-    double t[6];
-    dipole_tensor({X[0], X[1], X[2]}, 0.0, t);  // H = T mu, mu = M V_b, H = -N M
-    const double vb = 8.0 * half_b[0] * half_b[1] * half_b[2];
-    for (int a = 0; a < 6; ++a) n[a] = -t[a] * vb;
-    if (dn) {
-      // The point dipole's gradient at the signed d, as cube_demag_tensor_at.
-      const Vec3 r{d[0], d[1], d[2]};
-      const DipoleCoefficients c = dipole_coefficients(X[0] * X[0] + X[1] * X[1] + X[2] * X[2], 0.0);
-      static constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
-      for (int k = 0; k < 3; ++k)
-        for (int m = 0; m < 6; ++m) {
-          const int a = row[m], b = col[m];
-          double v = c.C * r[k] * r[a] * r[b];
-          if (a == b) v += c.B * r[k];
-          if (a == k) v += c.B * r[b];
-          if (b == k) v += c.B * r[a];
-          dn[k][m] = -vb * v;
-        }
-    }
+    // At the signed d, so the signs below are not applied again.
+    point_dipole_demag(Vec3{d[0], d[1], d[2]}, X[0] * X[0] + X[1] * X[1] + X[2] * X[2],
+                       8.0 * half_b[0] * half_b[1] * half_b[2], n, dn);
+    return;
   } else {
     // Per axis: the four corner differences of the two intervals and their
     // weights (the double integral of a function of x - x' over both
