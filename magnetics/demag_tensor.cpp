@@ -1,6 +1,7 @@
 #include "magnetics/demag_tensor.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "magnetics/constants.h"
@@ -29,6 +30,28 @@ void point_dipole_demag(const Vec3& d, double r2, double volume, double n[6], do
       if (a == k) v += c.B * d[b];
       if (b == k) v += c.B * d[a];
       dn[k][m] = -volume * v;
+    }
+}
+
+// Which components of N are odd in each axis (xx, xy, xz, yy, yz, zz).
+constexpr int kOddIn[6][3] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, {0, 0, 0}, {0, 1, 1}, {0, 0, 0}};
+
+// The sign of each component of d (0 for a zero component).
+std::array<double, 3> axis_signs(const double d[3]) {
+  std::array<double, 3> s{};
+  for (int k = 0; k < 3; ++k) s[k] = d[k] < 0.0 ? -1.0 : (d[k] > 0.0 ? 1.0 : 0.0);
+  return s;
+}
+
+// dN/dd at the signed d from c du, the gradient computed at |d|: axis k's
+// sign moves from the components odd in it to the even ones.
+void signed_gradient(double c, const double du[3][6], const std::array<double, 3>& sign, double (*dn)[6]) {
+  for (int k = 0; k < 3; ++k)
+    for (int m = 0; m < 6; ++m) {
+      double v = c * du[k][m];
+      for (int j = 0; j < 3; ++j)
+        if ((j == k) != (kOddIn[m][j] != 0)) v *= sign[j];
+      dn[k][m] = v;
     }
 }
 
@@ -183,10 +206,8 @@ void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)
   // yy, zz) or g (xy, xz, yz) with its arguments in the order order[m].
   static constexpr int order[6][3] = {{0, 1, 2}, {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 1, 0}};
   static constexpr bool is_f[6] = {true, false, false, true, false, true};
-  static constexpr int odd[6][3] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, {0, 0, 0}, {0, 1, 1}, {0, 0, 0}};
   static constexpr double w[3] = {-1.0, 2.0, -1.0};
-  const double sign[3] = {d[0] < 0.0 ? -1.0 : (d[0] > 0.0 ? 1.0 : 0.0), d[1] < 0.0 ? -1.0 : (d[1] > 0.0 ? 1.0 : 0.0),
-                          d[2] < 0.0 ? -1.0 : (d[2] > 0.0 ? 1.0 : 0.0)};
+  const std::array<double, 3> sign = axis_signs(d);
   const double X = std::fabs(d[0]), Y = std::fabs(d[1]), Z = std::fabs(d[2]);
   double u[6] = {}, du[3][6] = {};  // the tensor at |d| and its gradient
   for (int a = 0; a < 3; ++a)
@@ -206,29 +227,18 @@ void cube_demag_tensor_at(const double d[3], double h, double n[6], double (*dn)
   for (int m = 0; m < 6; ++m) {
     n[m] = c * u[m];
     for (int k = 0; k < 3; ++k)
-      if (odd[m][k]) n[m] *= sign[k];
+      if (kOddIn[m][k]) n[m] *= sign[k];
   }
-  if (!dn) return;
-  // d/dd_k of a component restored with signs: axis k's sign moves from the
-  // odd components to the even ones.
-  for (int k = 0; k < 3; ++k)
-    for (int m = 0; m < 6; ++m) {
-      double v = c * du[k][m];
-      for (int j = 0; j < 3; ++j)
-        if ((j == k) != (odd[m][j] != 0)) v *= sign[j];
-      dn[k][m] = v;
-    }
+  if (dn) signed_gradient(c, du, sign, dn);
 }
 
 void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const double d[3], double n[6],
                          double (*dn)[6]) {
-  const double sign[3] = {d[0] < 0.0 ? -1.0 : (d[0] > 0.0 ? 1.0 : 0.0), d[1] < 0.0 ? -1.0 : (d[1] > 0.0 ? 1.0 : 0.0),
-                          d[2] < 0.0 ? -1.0 : (d[2] > 0.0 ? 1.0 : 0.0)};
+  const std::array<double, 3> sign = axis_signs(d);
   const double X[3] = {std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])};
   double edge = 0.0;
   for (int k = 0; k < 3; ++k) edge = std::max({edge, 2.0 * half_a[k], 2.0 * half_b[k]});
   const double range = kNewellRange * edge;
-  static constexpr int odd[6][3] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, {0, 0, 0}, {0, 1, 1}, {0, 0, 0}};
   double du[3][6] = {};  // the gradient at |d| (Newell branch)
   if (X[0] * X[0] + X[1] * X[1] + X[2] * X[2] > range * range) {
     // At the signed d, so the signs below are not applied again.
@@ -263,16 +273,7 @@ void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const d
         }
     const double c = 1.0 / (4.0 * kPi * 8.0 * half_a[0] * half_a[1] * half_a[2]);
     for (int m = 0; m < 6; ++m) n[m] = c * sum[m];
-    if (dn)
-      // d/dd_k of a component restored with signs: axis k's sign moves from
-      // the odd components to the even ones (as cube_demag_tensor_at).
-      for (int k = 0; k < 3; ++k)
-        for (int m = 0; m < 6; ++m) {
-          double v = c * du[k][m];
-          for (int j = 0; j < 3; ++j)
-            if ((j == k) != (odd[m][j] != 0)) v *= sign[j];
-          dn[k][m] = v;
-        }
+    if (dn) signed_gradient(c, du, sign, dn);
   }
   // Components odd in an axis take its sign (zero offset: they vanish).
   n[1] *= sign[0] * sign[1];
