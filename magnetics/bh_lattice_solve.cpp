@@ -99,9 +99,11 @@ BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, 
   // R(H) = H - H_source - H_d(w f(H)) of (4), |R| / |H_source|; sets m = w f(H), J,
   // and g = |G| / |w f(H)|, the residual of (3) at M = m.
   double g = 0.0;
+  BhSolveReport report;
   auto residual = [&](const std::vector<Vec3>& h, std::vector<Vec3>& r) {
     for (int i = 0; i < N; ++i) m[i] = bh_cell_law(curve, fill[i], h[i], J[i].data());
     demag.field(m, Hd);
+    ++report.matvecs;
     double rr = 0.0, gg = 0.0, mm = 0.0;
     for (int i = 0; i < N; ++i) {
       r[i] = h[i] - H_source[i] - Hd[i];
@@ -113,13 +115,13 @@ BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, 
     g = mm > 0.0 ? std::sqrt(gg / mm) : std::sqrt(gg);
     return source > 0.0 ? std::sqrt(rr) / source : std::sqrt(rr);
   };
-  BhSolveReport report;
   // The initial field: from the initial M; for M = 0, H = 0, so that the
   // first Newton step is the linear solve with the initial susceptibility.
   bool zero = true;
   for (const Vec3& v : M) zero = zero && squared_norm(v) == 0.0;
   if (!zero) {
     demag.field(M, Hd);
+    ++report.matvecs;
     for (int i = 0; i < N; ++i) H[i] = H_source[i] + Hd[i];
   }
   double r = residual(H, R);
@@ -128,6 +130,7 @@ BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, 
   auto apply = [&](const VectorXd& x, VectorXd& y) {  // (I + N J) x, N v = -H_d(v)
     for (int i = 0; i < N; ++i) x3[i] = symmetric_times(J[i].data(), Vec3{x(3 * i), x(3 * i + 1), x(3 * i + 2)});
     demag.field(x3, y3);
+    ++report.matvecs;
     y = x;
     for (int i = 0; i < N; ++i) y.segment<3>(3 * i) -= Eigen::Vector3d(y3[i].x, y3[i].y, y3[i].z);
   };

@@ -45,6 +45,7 @@ struct BhSolveReport {
   bool converged = false;
   int newton_iterations = 0;
   int krylov_iterations = 0;     // all GMRES iterations (one FFT matvec each)
+  int matvecs = 0;               // all demagnetizing-field evaluations (GMRES, restarts, residuals)
   double residual = 0.0;         // final |G| / |w f(H)| of (3)
   std::vector<double> residuals; // the same, before the first and after each Newton step
 };

@@ -119,6 +119,11 @@ TEST(BhLatticeSolve, SoftCubeConvergesOntoTheCurve) {
     std::vector<Vec3> M(64);
     const BhSolveReport report = solve_bh_lattice(demag, curve, fill, source, M);
     EXPECT_TRUE(report.converged) << Ha;
+    // Field evaluations: one per GMRES iteration, at least one residual per
+    // Newton step and the initial one; at most one more per GMRES restart
+    // cycle and ten more halvings per step.
+    EXPECT_GE(report.matvecs, report.krylov_iterations + report.newton_iterations + 1) << Ha;
+    EXPECT_LE(report.matvecs, 2 * report.krylov_iterations + 11 * report.newton_iterations + 1) << Ha;
     std::vector<Vec3> Hd;
     demag.field(M, Hd);
     for (int i = 0; i < 64; ++i) {
