@@ -239,42 +239,40 @@ void cuboid_demag_tensor(const double half_a[3], const double half_b[3], const d
   double edge = 0.0;
   for (int k = 0; k < 3; ++k) edge = std::max({edge, 2.0 * half_a[k], 2.0 * half_b[k]});
   const double range = kNewellRange * edge;
-  double du[3][6] = {};  // the gradient at |d| (Newell branch)
-  if (X[0] * X[0] + X[1] * X[1] + X[2] * X[2] > range * range) {
-    // At the signed d, so the signs below are not applied again.
-    point_dipole_demag(Vec3{d[0], d[1], d[2]}, X[0] * X[0] + X[1] * X[1] + X[2] * X[2],
-                       8.0 * half_b[0] * half_b[1] * half_b[2], n, dn);
+  const double r2 = X[0] * X[0] + X[1] * X[1] + X[2] * X[2];
+  if (r2 > range * range) {
+    // At the signed d: the signs restored below are already in it.
+    point_dipole_demag(Vec3{d[0], d[1], d[2]}, r2, 8.0 * half_b[0] * half_b[1] * half_b[2], n, dn);
     return;
-  } else {
-    // Per axis: the four corner differences of the two intervals and their
-    // weights (the double integral of a function of x - x' over both
-    // intervals is this combination of its second antiderivative).
-    double u[3][4];
-    for (int k = 0; k < 3; ++k) {
-      const double s = half_a[k] + half_b[k], t = half_a[k] - half_b[k];
-      u[k][0] = X[k] - s, u[k][1] = X[k] - t, u[k][2] = X[k] + t, u[k][3] = X[k] + s;
-    }
-    static constexpr double w[4] = {-1.0, 1.0, 1.0, -1.0};
-    static constexpr int order[6][3] = {{0, 1, 2}, {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 1, 0}};
-    static constexpr bool is_f[6] = {true, false, false, true, false, true};
-    double sum[6] = {0, 0, 0, 0, 0, 0};
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int e = 0; e < 4; ++e) {
-          const double wt = w[a] * w[b] * w[e];
-          const NewellPoint pt(u[0][a], u[1][b], u[2][e]);
-          for (int m = 0; m < 6; ++m) {
-            const int* o = order[m];
-            double g[3];
-            sum[m] += wt * (is_f[m] ? pt.f(o[0], o[1], o[2], g) : pt.g(o[0], o[1], o[2], g));
-            if (dn)  // every corner difference moves with X_k: d/dX_k is the antiderivative's derivative
-              for (int q = 0; q < 3; ++q) du[o[q]][m] += wt * g[q];
-          }
-        }
-    const double c = 1.0 / (4.0 * kPi * 8.0 * half_a[0] * half_a[1] * half_a[2]);
-    for (int m = 0; m < 6; ++m) n[m] = c * sum[m];
-    if (dn) signed_gradient(c, du, sign, dn);
   }
+  // Per axis: the four corner differences of the two intervals and their
+  // weights (the double integral of a function of x - x' over both
+  // intervals is this combination of its second antiderivative).
+  double u[3][4];
+  for (int k = 0; k < 3; ++k) {
+    const double s = half_a[k] + half_b[k], t = half_a[k] - half_b[k];
+    u[k][0] = X[k] - s, u[k][1] = X[k] - t, u[k][2] = X[k] + t, u[k][3] = X[k] + s;
+  }
+  static constexpr double w[4] = {-1.0, 1.0, 1.0, -1.0};
+  static constexpr int order[6][3] = {{0, 1, 2}, {0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 1, 0}};
+  static constexpr bool is_f[6] = {true, false, false, true, false, true};
+  double sum[6] = {0, 0, 0, 0, 0, 0}, du[3][6] = {};  // the tensor at |d| and its gradient
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      for (int e = 0; e < 4; ++e) {
+        const double wt = w[a] * w[b] * w[e];
+        const NewellPoint pt(u[0][a], u[1][b], u[2][e]);
+        for (int m = 0; m < 6; ++m) {
+          const int* o = order[m];
+          double g[3];
+          sum[m] += wt * (is_f[m] ? pt.f(o[0], o[1], o[2], g) : pt.g(o[0], o[1], o[2], g));
+          if (dn)  // every corner difference moves with X_k: d/dX_k is the antiderivative's derivative
+            for (int q = 0; q < 3; ++q) du[o[q]][m] += wt * g[q];
+        }
+      }
+  const double c = 1.0 / (4.0 * kPi * 8.0 * half_a[0] * half_a[1] * half_a[2]);
+  for (int m = 0; m < 6; ++m) n[m] = c * sum[m];
+  if (dn) signed_gradient(c, du, sign, dn);
   // Components odd in an axis take its sign (zero offset: they vanish).
   n[1] *= sign[0] * sign[1];
   n[2] *= sign[0] * sign[2];

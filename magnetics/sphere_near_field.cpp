@@ -60,8 +60,8 @@
 // by O(kReuseTolerance^2) and the forces by O(kReuseTolerance) of the
 // correction (measured 2.5e-6 of a close pair's force at 0.9 of it;
 // docs/model.md "Carried-over pairs"); overlapping pairs are evaluated every
-// time. Balls resting in a
-// heap or hanging together move by far less than that between substeps.
+// time. Balls resting in a heap or hanging together move by far less than
+// that between substeps.
 //
 // Pairs, not clusters: the higher orders of a sphere excited by two
 // neighbours are the sum of the two pairs' (linear), but the cross terms
@@ -413,7 +413,6 @@ class SphereNearField final : public NearFieldTerm {
     if (model.generation() != generation_) previous_.clear();
     pairs_.clear();
     generation_ = model.generation();
-    const std::vector<SpherePair>& previous = previous_;
     size_t next_previous = 0;
     std::map<std::pair<int, int>, std::shared_ptr<const PairTable>> tables;  // by (type a, type b)
     std::pair<int, int> last_types{-1, -1};
@@ -440,12 +439,13 @@ class SphereNearField final : public NearFieldTerm {
         // Coincident centres: any axis (the functions are constant there).
         const Vec3 u = d > 0.0 ? r / d : Vec3{0.0, 0.0, 1.0};
         // Carried over: the pair's last evaluation, if close enough (header comment).
-        while (next_previous < previous.size() &&
-               std::make_pair(previous[next_previous].a, previous[next_previous].b) < std::make_pair(ca.cell, cb.cell))
+        const std::pair<int, int> key{ca.cell, cb.cell};
+        while (next_previous < previous_.size() &&
+               std::make_pair(previous_[next_previous].a, previous_[next_previous].b) < key)
           ++next_previous;
-        if (next_previous < previous.size() && previous[next_previous].a == ca.cell &&
-            previous[next_previous].b == cb.cell) {
-          const SpherePair& q = previous[next_previous];
+        if (next_previous < previous_.size() &&
+            std::make_pair(previous_[next_previous].a, previous_[next_previous].b) == key) {
+          const SpherePair& q = previous_[next_previous];
           const double delta = d - q.d0;
           if (q.d0 > reach && std::fabs(delta) <= kReuseTolerance * std::min(q.d0 - reach, reach)) {
             SpherePair& p = pairs_.emplace_back(q);
@@ -577,7 +577,7 @@ class SphereNearField final : public NearFieldTerm {
   std::vector<SpherePair> previous_;  // the build before, for the carry-over
   std::vector<Vec3> centre_;           // scratch of build: the spheres' centres
   std::vector<double> radius_;         // and radii
-  uint64_t generation_ = 0;        // the model whose pairs pairs_ holds
+  uint64_t generation_ = 0;           // the model whose pairs pairs_ holds
   mutable SphereMoments moments_;  // scratch of the sums (the backends call them from one thread)
 };
 
