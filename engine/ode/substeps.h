@@ -8,6 +8,7 @@
 
 #include <ode/ode.h>
 
+#include <functional>
 #include <vector>
 
 #include "magnetics/model.h"
@@ -60,8 +61,13 @@ class SubstepRule {
 
   // Substeps of dt needed for collision (travel) and for the magnetic force's
   // time scale (stiffness), before the cap max_substeps. motion: one per
-  // body; gravity: |g|, m/s^2; external_field: |H_E|, A/m.
-  int needed(double dt, const std::vector<SubstepMotion>& motion, double gravity, double external_field) const;
+  // body; gravity: |g|, m/s^2; external_field: |H_E|, A/m. clearance, when
+  // given: a lower bound of the distance (m) from body b to every other
+  // body and the ground, asked only for a body in free flight, pulled by a
+  // magnetic force no larger than its weight, whose travel bound would
+  // shorten the substep; it may then cover half of it as well.
+  int needed(double dt, const std::vector<SubstepMotion>& motion, double gravity, double external_field,
+             const std::function<double(int)>& clearance = {}) const;
 
   // The count in use after the rule wanted `wanted` (needed()) at `time`,
   // s: raised at once, lowered only at a step's start (step_start) after a

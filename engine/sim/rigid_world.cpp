@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <variant>
 
 #include "engine/ode/magnetic_forces.h"
@@ -202,6 +203,26 @@ void RigidWorld::integrate(double h) {
   dJointGroupEmpty(contacts_);
   random_seed_ = dRandGetSeed();
   dRandSetSeed(process_seed);
+}
+
+double RigidWorld::clearance(int i) const {
+  if (!bodies_[i].geom) return 0.0;
+  dReal own[6], other[6];  // min x, max x, min y, max y, min z, max z
+  dGeomGetAABB(bodies_[i].geom, own);
+  double nearest = std::numeric_limits<double>::infinity();
+  const int n = dSpaceGetNumGeoms(space_);
+  for (int g = 0; g < n; ++g) {  // in order: ODE's spaces are fast at sequential access
+    const dGeomID geom = dSpaceGetGeom(space_, g);
+    if (geom == bodies_[i].geom) continue;
+    dGeomGetAABB(geom, other);
+    double gap2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double gap = std::max({other[2 * k] - own[2 * k + 1], own[2 * k] - other[2 * k + 1], 0.0});
+      gap2 += gap * gap;
+    }
+    nearest = std::min(nearest, gap2);
+  }
+  return std::sqrt(nearest);
 }
 
 void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {

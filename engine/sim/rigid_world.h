@@ -56,6 +56,11 @@ class RigidWorld {
   // Its contact points in the last integrate() (ODE's dCollide gives up to 8 per pair).
   int contact_count(int i) const { return bodies_[i].contacts; }
 
+  // A lower bound of the distance (m) from body i's collision geometry to
+  // every other geometry of the world, the ground included: the gap between
+  // their axis-aligned bounding boxes; 0 where they overlap.
+  double clearance(int i) const;
+
   BodyPose pose(int i) const;
   Vec3 velocity(int i) const;
   Vec3 angular_velocity(int i) const;

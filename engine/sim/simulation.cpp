@@ -148,7 +148,8 @@ int Simulation::substeps_needed(double dt) {
     if (substep_rule_.body(b).turns_in_field) m.moment = magnetics_->moment(b);
     m.in_contact = world_->in_contact(b);
   }
-  return substep_rule_.needed(dt, substep_motion_, norm(scene_.gravity), norm(magnetics_->external_field()));
+  return substep_rule_.needed(dt, substep_motion_, norm(scene_.gravity), norm(magnetics_->external_field()),
+                              [this](int b) { return world_->clearance(b); });
 }
 
 void Simulation::update_substeps(double dt, bool step_start, StepRecord& record) {

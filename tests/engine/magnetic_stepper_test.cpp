@@ -211,6 +211,48 @@ TEST(SubstepRule, TravelBoundAndHold) {
   EXPECT_EQ(rule.update(1000, 0.01, 0.001, false), 64) << "capped at max_substeps";
 }
 
+// A body in free flight may also cover half its clearance per substep: a
+// ball falling at 5 m/s (ten substeps of 0.5 mm by the tenth of its size)
+// with 7 mm to the nearest other body needs two (0.5 + 3.5 mm each); the
+// clearance is asked for only when the travel bound would bind, and neither
+// for a body in contact nor for one pulled by a magnetic force above its
+// weight (it grows steeply as the body nears the magnet).
+TEST(SubstepRule, FreeFlightMayCoverHalfItsClearance) {
+  SubstepRule rule;
+  rule.add_body({0.005, 0.0, 1e-9, false});
+  std::vector<SubstepMotion> motion(1);
+  motion[0].free = true;
+  motion[0].mass = 0.004;
+  const double g = 9.81;
+  int asked = 0;
+  double gap = 0.007;
+  auto clearance = [&](int b) {
+    EXPECT_EQ(b, 0);
+    ++asked;
+    return gap;
+  };
+  EXPECT_EQ(rule.needed(0.001, motion, g, 0.0, clearance), 1);
+  EXPECT_EQ(asked, 0) << "at rest: nothing to bound";
+  motion[0].velocity = {5.0, 0, 0};
+  EXPECT_EQ(rule.needed(0.001, motion, g, 0.0, clearance), 2);
+  EXPECT_EQ(asked, 1);
+  gap = 0.0;  // touching its bounding box: the tenth alone (10 substeps, 11 with gravity)
+  EXPECT_EQ(rule.needed(0.001, motion, g, 0.0, clearance), rule.needed(0.001, motion, g, 0.0));
+  EXPECT_GE(rule.needed(0.001, motion, g, 0.0), 10);
+  gap = 1.0;
+  EXPECT_EQ(rule.needed(0.001, motion, g, 0.0, clearance), 1);
+  motion[0].in_contact = true;
+  EXPECT_EQ(rule.needed(0.001, motion, g, 0.0, clearance), 10) << "in contact: the clearance does not count";
+  EXPECT_EQ(asked, 3);
+  motion[0].in_contact = false;
+  motion[0].force = {0.004 * g * 0.99, 0, 0};  // below its weight: counts
+  EXPECT_EQ(rule.needed(0.001, motion, g, 0.0, clearance), 1);
+  EXPECT_EQ(asked, 4);
+  motion[0].force = {0.004 * g * 1.01, 0, 0};  // above: the tenth alone
+  EXPECT_EQ(rule.needed(0.001, motion, g, 0.0, clearance), rule.needed(0.001, motion, g, 0.0));
+  EXPECT_EQ(asked, 4);
+}
+
 TEST(MagneticStepper, BadArgumentsThrow) {
   EmbedWorld w(0.0);
   EXPECT_THROW(MagneticStepper(w.magnetics, nullptr, w.space, &EmbedWorld::near_callback, &w, w.contacts),
