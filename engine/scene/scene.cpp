@@ -1267,8 +1267,9 @@ const KeyTable<OutcomeTarget> kOutcomeKeys = {
     {.name = "force", .read = read_quantity<5>, .doc = {"object", "", ""}},
     {.name = "moment", .read = read_quantity<6>, .doc = {"object", "", ""}},
     {.name = "time", .check = Check::number, .slot = SLOT(outcome.time), .doc = {"number", "s", "`-1`"}},
-    {.name = "statistic", .check = Check::choice, .slot = SLOT(outcome.statistic), .words = {"max", "min"},
+    {.name = "statistic", .check = Check::choice, .slot = SLOT(outcome.statistic), .words = {"max", "min", "mean"},
      .doc = {"string", "", "`\"\"`"}},
+    {.name = "from", .check = Check::non_negative, .slot = SLOT(outcome.from), .doc = {"number", "s", "`0`"}},
 };
 
 OutcomeDescription read_outcome(const SceneReader& r, const json& v, const std::string& path,
@@ -1282,7 +1283,9 @@ OutcomeDescription read_outcome(const SceneReader& r, const json& v, const std::
   OutcomeTarget t{{}, scene, index};
   read_object(r, v, path, kOutcomeKeys, t);
   if (!t.outcome.statistic.empty() && v.contains("time"))
-    r.fail(member(path, "time"), "an outcome with a statistic (max, min over the run) has no time");
+    r.fail(member(path, "time"), "an outcome with a statistic (max, min, mean over the run) has no time");
+  if (t.outcome.statistic.empty() && v.contains("from"))
+    r.fail(member(path, "from"), "only an outcome with a statistic (max, min, mean) has a start time");
   return t.outcome;
 }
 

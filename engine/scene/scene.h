@@ -175,7 +175,8 @@ struct OutcomeDescription {
   std::vector<std::string> bodies;  // the body; two for distance
   int component = -1;               // force, moment: 0, 1, 2 for x, y, z; -1: the magnitude
   double time = -1.0;               // s; when to evaluate; negative: at the end of the run
-  std::string statistic;            // "max" or "min" over every step of the run; "": at `time`
+  std::string statistic;            // "max", "min" or "mean" over every step from `from` on; "": at `time`
+  double from = 0.0;                // s; a statistic's first sample (steps at t >= from)
 };
 
 struct SceneDescription {

@@ -42,9 +42,13 @@ void OutcomeRecorder::sample(const SceneDescription& scene, double time, double 
   for (size_t i = 0; i < scene.outcomes.size(); ++i) {
     const OutcomeDescription& o = scene.outcomes[i];
     if (!o.statistic.empty()) {
+      if (time + 0.5 * dt < o.from) continue;
       const double v = outcome_value(o, scene, world, magnetics);
-      running_[i] = !seen_[i] ? v : o.statistic == "max" ? std::max(running_[i], v) : std::min(running_[i], v);
-      seen_[i] = 1;
+      if (!seen_[i]) running_[i] = v;
+      else if (o.statistic == "max") running_[i] = std::max(running_[i], v);
+      else if (o.statistic == "min") running_[i] = std::min(running_[i], v);
+      else running_[i] += v;  // mean: the sum, divided at the end
+      ++seen_[i];
     } else if (o.time >= 0.0 && !values_.count(o.name) && time + 0.5 * dt >= o.time) {
       values_[o.name] = outcome_value(o, scene, world, magnetics);
     }
@@ -56,7 +60,11 @@ void OutcomeRecorder::finish(const SceneDescription& scene, const RigidWorld& wo
     const OutcomeDescription& o = scene.outcomes[i];
     if (values_.count(o.name)) continue;
     if (!o.statistic.empty()) {
-      values_[o.name] = seen_[i] ? running_[i] : outcome_value(o, scene, world, magnetics);
+      if (!seen_[i]) {
+        if (o.from <= 0.0) values_[o.name] = outcome_value(o, scene, world, magnetics);
+      } else {  // a start time the run did not reach: left out
+        values_[o.name] = o.statistic == "mean" ? running_[i] / static_cast<double>(seen_[i]) : running_[i];
+      }
     } else if (o.time < 0.0) {
       values_[o.name] = outcome_value(o, scene, world, magnetics);
     }  // a time the run did not reach: left out

@@ -1,6 +1,6 @@
 // Scene outcomes (docs/scene-format.md "outcomes"): the numbers a run reports
 // in its summary, taken from the rigid world and the magnetics at a time, at
-// the end, or as the largest or smallest value over every rigid step.
+// the end, or as the largest, smallest or mean value over the rigid steps.
 #pragma once
 
 #include <map>
@@ -31,8 +31,8 @@ class OutcomeRecorder {
 
  private:
   std::map<std::string, double> values_;
-  std::vector<double> running_;  // per outcome: max or min so far (statistics)
-  std::vector<char> seen_;       // per outcome: running_ holds a value
+  std::vector<double> running_;  // per outcome: max, min or sum so far (statistics)
+  std::vector<long> seen_;       // per outcome: the samples in running_
 };
 
 }  // namespace odemag

@@ -403,7 +403,10 @@ TEST_F(Cli, RelayArmatureClosesWhileTheCoilIsOnAndOpensAfter) {
 // examples/superconductor_levitation.json: a chi = -1 ball (5 mm, 6300
 // kg/m^3) dropped into a chimney over a magnet hovers: at the end it is well
 // above the magnet (top at 20 mm; measured centre 47 mm) and the magnetic
-// lift carries its weight (measured 1.0% above it, still settling).
+// lift, its mean over the last 0.5 s, carries its weight (measured 0.14%
+// below it). The lift at one time swings by about 4% about the weight: the
+// hover still oscillates by 0.2 mm, too slowly for ODE's damping threshold,
+// so a value at the end depended on the phase (+0.9% and +3.7% in two builds).
 TEST_F(Cli, SuperconductingBallHoversOverTheMagnet) {
   const json outcomes = example_outcomes("superconductor_levitation");
   ASSERT_FALSE(outcomes.is_null());
@@ -411,7 +414,7 @@ TEST_F(Cli, SuperconductingBallHoversOverTheMagnet) {
   EXPECT_GT(outcomes["lowest"].get<double>(), 0.03) << "the ball never comes near the magnet";
   EXPECT_GT(outcomes["hover_height"].get<double>(), 0.035);
   EXPECT_LT(outcomes["hover_height"].get<double>(), 0.07);
-  EXPECT_NEAR(outcomes["lift"].get<double>(), weight, 0.03 * weight);
+  EXPECT_NEAR(outcomes["lift"].get<double>(), weight, 0.01 * weight);
 }
 
 TEST_F(Cli, UsageErrorsExitTwo) {

@@ -424,6 +424,14 @@ TEST(SceneParser, RejectsOutOfRangeSettings) {
              "bodies[0].density");
   expect_key(scene_with(R"("outcomes": [{"name": "x", "count_above": {"prefix": "a"}}])"),
              "outcomes[0].count_above.height");
+  // A statistic's start time: >= 0, and only with a statistic; a statistic has no `time`.
+  expect_key(scene_with(R"("outcomes": [{"name": "x", "height": {"body": "a"}, "statistic": "mean", "from": -1}])"),
+             "outcomes[0].from");
+  expect_key(scene_with(R"("outcomes": [{"name": "x", "height": {"body": "a"}, "from": 0.5}])"), "outcomes[0].from");
+  expect_key(scene_with(R"("outcomes": [{"name": "x", "height": {"body": "a"}, "statistic": "mean", "time": 1}])"),
+             "outcomes[0].time");
+  expect_key(scene_with(R"("outcomes": [{"name": "x", "height": {"body": "a"}, "statistic": "median"}])"),
+             "outcomes[0].statistic");
 }
 
 TEST(SceneParser, RejectsHugeLattice) {

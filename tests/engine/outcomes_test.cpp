@@ -68,5 +68,43 @@ TEST(Outcomes, EachQuantityAtATimeAtTheEndAndOverTheRun) {
   EXPECT_EQ(v.count("never"), 0u);  // a time the run did not reach
 }
 
+// "mean" over the steps from `from` on: the ball rests on the magnet from
+// well before 0.5 s, so the mean of its height equals its height at the end
+// (to the contact's settling), and a statistic's start time the run does
+// not reach leaves the outcome out. A falling ball's mean speed over the
+// whole run lies between its smallest and largest.
+TEST(Outcomes, MeanFromAStartTime) {
+  using Q = OutcomeDescription::Quantity;
+  const double R = 0.008, r = 0.005;
+  SceneDescription s;
+  s.file = "outcomes_mean";
+  s.simulation.time_step = 0.002;
+  s.materials["magnet"] = PermanentMaterial{{0, 0, 9e5}, 0.0};
+  s.materials["steel"] = steel();
+  s.bodies.push_back(body("magnet", Sphere{R}, "magnet", {0, 0, R}, true));
+  s.bodies.push_back(body("ball", Sphere{r}, "steel", {0, 0, 0.045}));
+  s.outcomes = {outcome("height_end", Q::height, {"ball"}), outcome("height_mean", Q::height, {"ball"}, -1.0, "mean"),
+                outcome("speed_mean", Q::speed, {"ball"}, -1.0, "mean"),
+                outcome("speed_max", Q::speed, {"ball"}, -1.0, "max"),
+                outcome("speed_min", Q::speed, {"ball"}, -1.0, "min"),
+                outcome("late", Q::height, {"ball"}, -1.0, "mean")};
+  s.outcomes[1].from = 0.5;
+  s.outcomes[5].from = 99.0;
+  Simulation sim(s);
+  double sum = 0.0;
+  int samples = 0;
+  while (sim.time() < 1.0 - 1e-9) {
+    sim.step();
+    if (sim.time() + 0.5 * 0.002 >= 0.5) sum += sim.world().pose(1).position.z, ++samples;
+  }
+  sim.finish();
+  const auto& v = sim.outcomes();
+  EXPECT_NEAR(v.at("height_mean"), sum / samples, 1e-15);
+  EXPECT_NEAR(v.at("height_mean"), v.at("height_end"), 1e-4);
+  EXPECT_GT(v.at("speed_mean"), v.at("speed_min"));
+  EXPECT_LT(v.at("speed_mean"), v.at("speed_max"));
+  EXPECT_EQ(v.count("late"), 0u);
+}
+
 }  // namespace
 }  // namespace odemag
