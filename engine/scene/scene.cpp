@@ -976,9 +976,9 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
        read_object(r, x, p, kContactKeys, s.contact);
      },
      .doc = {"object", "", ""}},
-    {.name = "linear_damping", .check = Check::non_negative, .slot = SLOT(linear_damping),
+    {.name = "linear_damping", .check = Check::in_range, .slot = SLOT(linear_damping), .lo = 0.0, .hi = 1.0,
      .doc = {"number", "", "`0`"}},
-    {.name = "angular_damping", .check = Check::non_negative, .slot = SLOT(angular_damping),
+    {.name = "angular_damping", .check = Check::in_range, .slot = SLOT(angular_damping), .lo = 0.0, .hi = 1.0,
      .doc = {"number", "", "`0`"}},
     {.name = "max_substeps", .check = Check::integer, .slot = SLOT(max_substeps), .lo = 1, .hi = 100000,
      .doc = {"integer", "", "`64`"}},

@@ -1,6 +1,7 @@
 #include "engine/sim/rigid_world.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <variant>
@@ -51,8 +52,9 @@ RigidWorld::RigidWorld(const SceneDescription& scene) : contact_(scene.simulatio
   // Penetration is resolved at a bounded speed, so strong magnetic pulls
   // into a contact do not make bodies jump apart (see also the skin below).
   dWorldSetContactMaxCorrectingVel(world_, 0.1);
-  dWorldSetLinearDamping(world_, scene.simulation.linear_damping);
-  dWorldSetAngularDamping(world_, scene.simulation.angular_damping);
+  linear_damping_ = scene.simulation.linear_damping;
+  angular_damping_ = scene.simulation.angular_damping;
+  time_step_ = scene.simulation.time_step;
   if (scene.simulation.ground)
     ground_ = dCreatePlane(space_, 0, 0, 1, scene.simulation.ground_height);
 
@@ -195,6 +197,19 @@ void RigidWorld::integrate(double h) {
   const unsigned long process_seed = dRandGetSeed();
   dRandSetSeed(random_seed_);
   dSpaceCollide(space_, this, &RigidWorld::near_callback);
+  // ODE damps once per step it takes: scaled so that the substeps of a rigid
+  // step damp together by the scene's factor, whatever their count (each
+  // body keeps the values it was given; set again when h changes).
+  if ((linear_damping_ > 0.0 || angular_damping_ > 0.0) && h != damped_step_) {
+    const double share = h / time_step_;
+    const double linear = 1.0 - std::pow(1.0 - linear_damping_, share);
+    const double angular = 1.0 - std::pow(1.0 - angular_damping_, share);
+    for (Body& b : bodies_) {
+      dBodySetLinearDamping(b.body, linear);
+      dBodySetAngularDamping(b.body, angular);
+    }
+    damped_step_ = h;
+  }
   if (exact_solver_) {
     dWorldStep(world_, h);
   } else {

@@ -91,6 +91,10 @@ class RigidWorld {
   std::vector<ForceAccumulator*> accumulators_;
   ContactSettings contact_;
   bool exact_solver_ = false;
+  // The scene's damping factors per rigid step of time_step_ s (integrate
+  // spreads them over the substeps).
+  double linear_damping_ = 0.0, angular_damping_ = 0.0, time_step_ = 1.0;
+  double damped_step_ = 0.0;  // the substep the bodies' damping was last set for
   // This world's state of ODE's random number generator (integrate); ODE's
   // initial seed, so that the first world of a process steps as before.
   unsigned long random_seed_ = 0;

@@ -137,6 +137,30 @@ TEST(FreeFlight, ClearanceBoundsTheGapAndAFallingBallLandsOnTheGround) {
   EXPECT_NEAR(sim.world().pose(0).position.z, 0.005, 2e-4) << "resting on the ground";
 }
 
+// simulation.linear_damping is a factor per rigid step, whatever the number
+// of substeps: a ball flying at 20 m/s along a bar 1 mm away (about 20
+// substeps a step by the travel bound) keeps 0.99^n of its speed after n
+// steps of linear_damping 0.01, as one substep a step would (ODE damps once
+// per step it takes, which gave 0.99^(20 n)).
+TEST(FreeFlight, DampingPerRigidStepWhateverTheSubsteps) {
+  SceneDescription s = test_support::weightless_scene("damping");
+  s.materials["wood"] = InertMaterial{};
+  s.bodies.push_back(body("ball", Sphere{0.005}, "wood", {0, 0, 0}, false, 7800.0));
+  s.bodies.back().velocity = {20.0, 0, 0};
+  s.bodies.push_back(body("bar", Box{{3.0, 0.01, 0.01}}, "wood", {1.5, 0.011, 0}, true));
+  s.simulation.time_step = 0.001;
+  s.simulation.linear_damping = 0.01;
+  Simulation sim(s);
+  int steps = 0, most = 0;
+  while (steps < 40) {
+    sim.step();
+    ++steps;
+    most = std::max(most, sim.records().back().substeps);
+  }
+  EXPECT_GE(most, 10) << "the bar's clearance keeps the substeps many";
+  EXPECT_NEAR(norm(sim.world().velocity(0)), 20.0 * std::pow(0.99, steps), 1e-9 * 20.0);
+}
+
 TEST(CompassNeedle, SmallAnglePeriodAndNoNetForce) {
   SceneDescription s = weightless_scene("compass");
   const double M = 8e5, R = 0.005, density = 7500.0, H = 2e3, theta0 = 0.05;
