@@ -178,15 +178,21 @@ TEST(MagneticStepper, OneRelaxationPerStep) {
   EXPECT_NEAR(w.gap(), 0.0, kTouching);
 }
 
+// The rule for one free steel ball of 5 mm radius and 4 g, at rest.
+void one_free_ball(SubstepRule& rule, std::vector<SubstepMotion>& motion) {
+  rule.add_body({0.005, 0.0, 1e-9, false});
+  motion.assign(1, SubstepMotion{});
+  motion[0].free = true;
+  motion[0].mass = 0.004;
+}
+
 // The rule: a body at rest far from anything needs one substep; a fast one
 // near its size's travel more; the count falls only at a step's start after
 // the hold time 2 pi dt / stiffness_limit.
 TEST(SubstepRule, TravelBoundAndHold) {
   SubstepRule rule;
-  rule.add_body({0.005, 0.0, 1e-9, false});
-  std::vector<SubstepMotion> motion(1);
-  motion[0].free = true;
-  motion[0].mass = 0.004;
+  std::vector<SubstepMotion> motion;
+  one_free_ball(rule, motion);
   EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 1);
   motion[0].velocity = {5.0, 0, 0};  // 5 mm per step: ten substeps of 0.5 mm
   EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 10);
@@ -219,10 +225,8 @@ TEST(SubstepRule, TravelBoundAndHold) {
 // weight (it grows steeply as the body nears the magnet).
 TEST(SubstepRule, FreeFlightMayCoverHalfItsClearance) {
   SubstepRule rule;
-  rule.add_body({0.005, 0.0, 1e-9, false});
-  std::vector<SubstepMotion> motion(1);
-  motion[0].free = true;
-  motion[0].mass = 0.004;
+  std::vector<SubstepMotion> motion;
+  one_free_ball(rule, motion);
   const double g = 9.81;
   int asked = 0;
   double gap = 0.007;

@@ -26,16 +26,25 @@ OutcomeDescription outcome(const std::string& name, OutcomeDescription::Quantity
   return o;
 }
 
-TEST(Outcomes, EachQuantityAtATimeAtTheEndAndOverTheRun) {
-  using Q = OutcomeDescription::Quantity;
-  const double R = 0.008, r = 0.005, z0 = 0.045;
+// A steel ball (radius kBallRadius) released at kStartHeight above a fixed
+// magnet ball (kMagnetRadius) on the ground falls onto it and stays.
+constexpr double kMagnetRadius = 0.008, kBallRadius = 0.005, kStartHeight = 0.045;
+
+SceneDescription ball_onto_magnet(const std::string& file) {
   SceneDescription s;
-  s.file = "outcomes";
+  s.file = file;
   s.simulation.time_step = 0.002;
   s.materials["magnet"] = PermanentMaterial{{0, 0, 9e5}, 0.0};
   s.materials["steel"] = steel();
-  s.bodies.push_back(body("magnet", Sphere{R}, "magnet", {0, 0, R}, true));
-  s.bodies.push_back(body("ball", Sphere{r}, "steel", {0, 0, z0}));
+  s.bodies.push_back(body("magnet", Sphere{kMagnetRadius}, "magnet", {0, 0, kMagnetRadius}, true));
+  s.bodies.push_back(body("ball", Sphere{kBallRadius}, "steel", {0, 0, kStartHeight}));
+  return s;
+}
+
+TEST(Outcomes, EachQuantityAtATimeAtTheEndAndOverTheRun) {
+  using Q = OutcomeDescription::Quantity;
+  const double R = kMagnetRadius, r = kBallRadius, z0 = kStartHeight;
+  SceneDescription s = ball_onto_magnet("outcomes");
   s.outcomes = {outcome("start_height", Q::height, {"ball"}, 0.0),
                 outcome("closest", Q::distance, {"ball", "magnet"}, -1.0, "min"),
                 outcome("farthest", Q::distance, {"ball", "magnet"}, -1.0, "max"),
@@ -75,14 +84,7 @@ TEST(Outcomes, EachQuantityAtATimeAtTheEndAndOverTheRun) {
 // whole run lies between its smallest and largest.
 TEST(Outcomes, MeanFromAStartTime) {
   using Q = OutcomeDescription::Quantity;
-  const double R = 0.008, r = 0.005;
-  SceneDescription s;
-  s.file = "outcomes_mean";
-  s.simulation.time_step = 0.002;
-  s.materials["magnet"] = PermanentMaterial{{0, 0, 9e5}, 0.0};
-  s.materials["steel"] = steel();
-  s.bodies.push_back(body("magnet", Sphere{R}, "magnet", {0, 0, R}, true));
-  s.bodies.push_back(body("ball", Sphere{r}, "steel", {0, 0, 0.045}));
+  SceneDescription s = ball_onto_magnet("outcomes_mean");
   s.outcomes = {outcome("height_end", Q::height, {"ball"}), outcome("height_mean", Q::height, {"ball"}, -1.0, "mean"),
                 outcome("speed_mean", Q::speed, {"ball"}, -1.0, "mean"),
                 outcome("speed_max", Q::speed, {"ball"}, -1.0, "max"),
