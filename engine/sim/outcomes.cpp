@@ -60,11 +60,11 @@ void OutcomeRecorder::finish(const SceneDescription& scene, const RigidWorld& wo
     const OutcomeDescription& o = scene.outcomes[i];
     if (values_.count(o.name)) continue;
     if (!o.statistic.empty()) {
-      if (!seen_[i]) {
-        if (o.from <= 0.0) values_[o.name] = outcome_value(o, scene, world, magnetics);
-      } else {  // a start time the run did not reach: left out
+      if (seen_[i]) {
         values_[o.name] = o.statistic == "mean" ? running_[i] / static_cast<double>(seen_[i]) : running_[i];
-      }
+      } else if (o.from <= 0.0) {  // no step taken: the state now
+        values_[o.name] = outcome_value(o, scene, world, magnetics);
+      }  // a start time the run did not reach: left out
     } else if (o.time < 0.0) {
       values_[o.name] = outcome_value(o, scene, world, magnetics);
     }  // a time the run did not reach: left out
