@@ -38,7 +38,7 @@ install(TARGETS odemag RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # #include; tests/install/install_test.cmake checks that).
 set(ODEMAG_PUBLIC_HEADERS
   engine/ode/magnetic_forces.h engine/ode/force_accumulator.h       # embedding
-  engine/ode/magnetic_stepper.h engine/ode/substeps.h
+  engine/ode/magnetic_stepper.h engine/ode/substeps.h engine/ode/exact_step.h
   engine/scene/scene.h                                              # scene loading
   engine/sim/simulation.h engine/sim/rigid_world.h engine/sim/frame_writer.h
   engine/sim/magnetic_system.h engine/sim/outcomes.h engine/sim/solve.h  # simulation

@@ -278,7 +278,8 @@ int wait_program(pid_t pid) {
 const std::vector<std::string>& summary_figures() {
   static const std::vector<std::string> figures = [] {
     std::vector<std::string> f = {"bodies", "cells", "responsive_cells", "time_step", "duration", "steps",
-                                  "frames", "wall_seconds", "steps_not_converged", "magnetic_steps_skipped"};
+                                  "frames", "wall_seconds", "steps_not_converged", "magnetic_steps_skipped",
+                                  "exact_solver_failures"};
     for (const char* group : {"magnetic_ms", "rigid_ms", "iterations", "substeps"})
       for (const char* s : {"median", "p90", "mean", "max", "total"}) f.push_back(std::string(group) + "." + s);
     return f;
@@ -379,8 +380,15 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
       {"substeps", statistics(substeps)},  // one relaxation per substep
       {"steps_not_converged", not_converged},
       {"magnetic_steps_skipped", skipped},  // substeps, with solver.skip_unchanged
+      {"exact_solver_failures", sim.world().exact_solver_failures()},  // substeps QuickStep took instead
       {"outcomes", outcomes},
   };
+  if (const long failures = sim.world().exact_solver_failures(); failures > 0)
+    std::fprintf(stderr,
+                 "odemag: ODE's exact contact solver failed in %ld substep%s (last: %s); QuickStep took %s "
+                 "(docs/simulation.md \"Contacts\")\n",
+                 failures, failures == 1 ? "" : "s", sim.world().last_exact_solver_failure().c_str(),
+                 failures == 1 ? "it" : "them");
   if (c.video) summary["video"] = *c.video;
   write_file_atomically((dir / "summary.json").string(), summary.dump(2) + "\n");
   return 0;

@@ -14,7 +14,10 @@ namespace {
 
 // dInitODE2 once per process, dCloseODE at exit.
 struct OdeLibrary {
-  OdeLibrary() { dInitODE2(0); }
+  OdeLibrary() {
+    dInitODE2(0);
+    throw_ode_internal_errors();  // ODE's internal errors end a run with a message, not abort()
+  }
   ~OdeLibrary() { dCloseODE(); }
 };
 
@@ -93,6 +96,8 @@ RigidWorld::RigidWorld(const SceneDescription& scene) : contact_(scene.simulatio
     if (!d.present) set_enabled(body_count() - 1, false);
   }
   for (const JointDescription& j : scene.joints) add_joint(scene, j);
+  for (const Body& b : bodies_) ode_bodies_.push_back(b.body);
+  if (exact_solver_) exact_step_ = std::make_unique<ExactStep>(world_);
 }
 
 void RigidWorld::add_joint(const SceneDescription& scene, const JointDescription& j) {
@@ -133,6 +138,7 @@ void RigidWorld::add_joint(const SceneDescription& scene, const JointDescription
 }
 
 RigidWorld::~RigidWorld() {
+  exact_step_.reset();  // gives the world back ODE's threading before it goes
   dJointGroupDestroy(contacts_);
   dSpaceDestroy(space_);  // destroys the geoms it holds
   dWorldDestroy(world_);  // destroys the bodies
@@ -211,7 +217,7 @@ void RigidWorld::integrate(double h) {
     damped_step_ = h;
   }
   if (exact_solver_) {
-    dWorldStep(world_, h);
+    exact_step_->step(ode_bodies_, h);  // QuickStep where ODE's exact solver fails
   } else {
     dWorldQuickStep(world_, h);
   }

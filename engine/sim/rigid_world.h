@@ -5,8 +5,11 @@
 
 #include <ode/ode.h>
 
+#include <memory>
+#include <string>
 #include <vector>
 
+#include "engine/ode/exact_step.h"
 #include "engine/ode/force_accumulator.h"
 #include "engine/scene/scene.h"
 #include "magnetics/state.h"
@@ -61,6 +64,11 @@ class RigidWorld {
   // their axis-aligned bounding boxes; 0 where they overlap.
   double clearance(int i) const;
 
+  // Substeps that ODE's exact solver failed on and QuickStep took instead
+  // (docs/simulation.md "Contacts"), and the last failure's message.
+  long exact_solver_failures() const { return exact_step_ ? exact_step_->failures() : 0; }
+  std::string last_exact_solver_failure() const { return exact_step_ ? exact_step_->last_failure() : ""; }
+
   BodyPose pose(int i) const;
   Vec3 velocity(int i) const;
   Vec3 angular_velocity(int i) const;
@@ -91,6 +99,8 @@ class RigidWorld {
   std::vector<ForceAccumulator*> accumulators_;
   ContactSettings contact_;
   bool exact_solver_ = false;
+  std::unique_ptr<ExactStep> exact_step_;  // with the exact solver
+  std::vector<dBodyID> ode_bodies_;        // every body, for ExactStep
   // The scene's damping factors per rigid step of time_step_ s (integrate
   // spreads them over the substeps).
   double linear_damping_ = 0.0, angular_damping_ = 0.0, time_step_ = 1.0;
