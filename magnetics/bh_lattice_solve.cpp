@@ -85,81 +85,128 @@ Vec3 bh_cell_law(const BhCurve& curve, double w, const Vec3& H, double jacobian[
   return m * u;
 }
 
+Vec3 bh_flux_cell_law(const BhCurve& curve, double w, const Vec3& b, Vec3& H, double jacobian[6]) {
+  // b = H + w f(H) along one direction: |b| = h + w M(h), dM/db = chi_d / (1 +
+  // chi_d) along b, M / |b| across (chi_d = w dM/dh).
+  const double beta = norm(b);
+  const double chi0 = w * curve.slope(0.0);
+  if (beta == 0.0) {
+    H = {};
+    const double d = chi0 / (1.0 + chi0);
+    for (int c = 0; c < 6; ++c) jacobian[c] = (c == 0 || c == 3 || c == 5) ? d : 0.0;
+    return {};
+  }
+  // |H| = h solves h + w M(h) = beta (monotone, slope >= 1): safeguarded Newton in [lo, hi].
+  double lo = std::max(0.0, beta - w * curve.saturation()), hi = beta;
+  double h = std::min(hi, std::max(lo, beta / (1.0 + chi0)));
+  for (int it = 0; it < 60; ++it) {
+    const double phi = h + w * curve.magnetization(h) - beta;
+    if (phi > 0.0) hi = h; else lo = h;
+    const double next = h - phi / (1.0 + w * curve.slope(h));
+    const double previous = h;
+    h = (next > lo && next < hi) ? next : 0.5 * (lo + hi);
+    if (std::abs(h - previous) <= 1e-14 * beta || hi - lo <= 1e-14 * beta) break;
+  }
+  const Vec3 u = b / beta;
+  const double m = beta - h;
+  H = h * u;
+  const double along = w * curve.slope(h) / (1.0 + w * curve.slope(h)), across = m / beta;
+  const double uu[6] = {u.x * u.x, u.x * u.y, u.x * u.z, u.y * u.y, u.y * u.z, u.z * u.z};
+  for (int c = 0; c < 6; ++c) jacobian[c] = (along - across) * uu[c] + ((c == 0 || c == 3 || c == 5) ? across : 0.0);
+  return m * u;
+}
+
 BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, const std::vector<double>& fill,
                                const std::vector<Vec3>& H_source, std::vector<Vec3>& M,
                                const BhSolveOptions& options) {
   const int N = demag.cells();
   M.resize(N);
-  std::vector<Vec3> H(N), R(N), trial(N), Hd, m(N);
+  std::vector<Vec3> x(N), R(N), trial(N), Hd, m(N);  // x: the Newton variable per cell
   std::vector<std::array<double, 6>> J(N);
   std::vector<Eigen::Matrix3d> block(N);
   double source = 0.0;
   for (const Vec3& h : H_source) source += squared_norm(h);
   source = std::sqrt(source);
-  // R(H) = H - H_source - H_d(w f(H)) of (4), |R| / |H_source|; sets m = w f(H), J,
-  // and g = |G| / |w f(H)|, the residual of (3) at M = m.
+  // x per cell: b = H + M for (5), H for (4). R(x) = H(x) - H_source -
+  // H_d(M(x)), |R| / |H_source|; sets m = M(x), H = H(x), J = dM/dx, and g =
+  // |G| / |M(x)|, the residual of (3) at M = m.
+  const bool flux = options.variable == BhNewtonVariable::flux_density;
+  std::vector<Vec3> H(N);
   double g = 0.0;
   BhSolveReport report;
-  auto residual = [&](const std::vector<Vec3>& h, std::vector<Vec3>& r) {
-    for (int i = 0; i < N; ++i) m[i] = bh_cell_law(curve, fill[i], h[i], J[i].data());
+  auto residual = [&](const std::vector<Vec3>& at, std::vector<Vec3>& r) {
+    for (int i = 0; i < N; ++i) {
+      if (flux) {
+        m[i] = bh_flux_cell_law(curve, fill[i], at[i], H[i], J[i].data());
+      } else {
+        m[i] = bh_cell_law(curve, fill[i], at[i], J[i].data());
+        H[i] = at[i];
+      }
+    }
     demag.field(m, Hd);
     ++report.matvecs;
     double rr = 0.0, gg = 0.0, mm = 0.0;
     for (int i = 0; i < N; ++i) {
-      r[i] = h[i] - H_source[i] - Hd[i];
+      r[i] = H[i] - H_source[i] - Hd[i];
       rr += squared_norm(r[i]);
       double unused[6];
-      gg += squared_norm(m[i] - bh_cell_law(curve, fill[i], h[i] - r[i], unused));
+      gg += squared_norm(m[i] - bh_cell_law(curve, fill[i], H[i] - r[i], unused));
       mm += squared_norm(m[i]);
     }
     g = mm > 0.0 ? std::sqrt(gg / mm) : std::sqrt(gg);
     return source > 0.0 ? std::sqrt(rr) / source : std::sqrt(rr);
   };
-  // The initial field: from the initial M; for M = 0, H = 0, so that the
-  // first Newton step is the linear solve with the initial susceptibility.
+  // The start: from the initial M (H = H_source + H_d(M), b = H + M); for M =
+  // 0, x = 0, so that the first Newton step is the linear solve with the
+  // initial susceptibility.
   bool zero = true;
   for (const Vec3& v : M) zero = zero && squared_norm(v) == 0.0;
   if (!zero) {
     demag.field(M, Hd);
     ++report.matvecs;
-    for (int i = 0; i < N; ++i) H[i] = H_source[i] + Hd[i];
+    for (int i = 0; i < N; ++i) x[i] = H_source[i] + Hd[i] + (flux ? M[i] : Vec3{});
   }
-  double r = residual(H, R);
+  double r = residual(x, R);
   report.residuals.push_back(g);
   std::vector<Vec3> x3(N), y3(N);
-  auto apply = [&](const VectorXd& x, VectorXd& y) {  // (I + N J) x, N v = -H_d(v)
-    for (int i = 0; i < N; ++i) x3[i] = symmetric_times(J[i].data(), Vec3{x(3 * i), x(3 * i + 1), x(3 * i + 2)});
+  // dR/dx v: (I + N J) v for (4), (I + (N - I) J) v for (5) (dH/db = I - J); N v = -H_d(v).
+  auto apply = [&](const VectorXd& v, VectorXd& y) {
+    for (int i = 0; i < N; ++i) x3[i] = symmetric_times(J[i].data(), Vec3{v(3 * i), v(3 * i + 1), v(3 * i + 2)});
     demag.field(x3, y3);
     ++report.matvecs;
-    y = x;
-    for (int i = 0; i < N; ++i) y.segment<3>(3 * i) -= Eigen::Vector3d(y3[i].x, y3[i].y, y3[i].z);
+    y = v;
+    for (int i = 0; i < N; ++i) {
+      y.segment<3>(3 * i) -= Eigen::Vector3d(y3[i].x, y3[i].y, y3[i].z);
+      if (flux) y.segment<3>(3 * i) -= Eigen::Vector3d(x3[i].x, x3[i].y, x3[i].z);
+    }
   };
-  auto precondition = [&](const VectorXd& x, VectorXd& y) {
+  auto precondition = [&](const VectorXd& v, VectorXd& y) {
     y.resize(3 * N);
-    for (int i = 0; i < N; ++i) y.segment<3>(3 * i) = block[i] * x.segment<3>(3 * i);
+    for (int i = 0; i < N; ++i) y.segment<3>(3 * i) = block[i] * v.segment<3>(3 * i);
   };
   double eta = options.forcing;
   while (g > options.tolerance && report.newton_iterations < options.max_newton) {
-    for (int i = 0; i < N; ++i) {  // (I + N(0) J_i)^-1, N(0) of the cell's lattice
+    for (int i = 0; i < N; ++i) {  // the cell's own block: N(0) of its lattice, less I for (5)
       const auto& n0 = demag.self_tensor(demag.lattice_of(i));
       Eigen::Matrix3d Ni;
       Ni << n0[0], n0[1], n0[2], n0[1], n0[3], n0[4], n0[2], n0[4], n0[5];
       Eigen::Matrix3d Ji;
       const auto& j = J[i];
       Ji << j[0], j[1], j[2], j[1], j[3], j[4], j[2], j[4], j[5];
+      if (flux) Ni -= Eigen::Matrix3d::Identity();
       block[i] = (Eigen::Matrix3d::Identity() + Ni * Ji).inverse();
     }
-    VectorXd dH;
-    const VectorXd b = -flat(R);
-    report.krylov_iterations += gmres(apply, precondition, b, dH, eta, options.restart, options.max_krylov);
+    VectorXd dx;
+    const VectorXd minus_R = -flat(R);
+    report.krylov_iterations += gmres(apply, precondition, minus_R, dx, eta, options.restart, options.max_krylov);
     // Backtracking on |R|: full step first, halved until |R| decreases.
     double step = 1.0, r_trial = 0.0;
     for (int halvings = 0;; ++halvings, step *= 0.5) {
-      for (int i = 0; i < N; ++i) trial[i] = H[i] + step * Vec3{dH(3 * i), dH(3 * i + 1), dH(3 * i + 2)};
+      for (int i = 0; i < N; ++i) trial[i] = x[i] + step * Vec3{dx(3 * i), dx(3 * i + 1), dx(3 * i + 2)};
       r_trial = residual(trial, R);
       if (r_trial < (1.0 - 1e-4 * step) * r || halvings == 10) break;
     }
-    H.swap(trial);
+    x.swap(trial);
     // Eisenstat-Walker forcing (choice 2): loose while |R| falls slowly, tight near the solution.
     const double previous = eta;
     eta = std::min(options.forcing, 0.9 * (r_trial / r) * (r_trial / r));

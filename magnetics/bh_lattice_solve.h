@@ -20,6 +20,17 @@
 // a step in M does; from M = 0 the solve starts at H = 0, whose first step is
 // the linear problem with the initial susceptibility. Converged when (3)'s
 // residual at M = w f(H) is below the tolerance.
+//
+// By default the Newton variable is the cells' b = H + M (B / mu0) instead
+// (docs/model.md "Nonlinear static solve"):
+//   R(b) = H(b) - H_source - H_d(M(b)) = 0,   M(b) = b - H(b)            (5)
+// with H(b) the inverse of b = H + w f(H) along b: both H(b) and M(b) have
+// slopes between 0 and 1 (dM/db = chi_d / (1 + chi_d) along b), so the cell
+// law is as mild at the knee of the curve as in saturation, where in H its
+// slope runs from the initial susceptibility through the largest to 0.
+// Newton matrix I + (N - I) J with J = dM/db, blocks (I + (N(0) - I) J_i)^-1.
+// Measured on TEAM 20: 3-7 Newton steps instead of 10-23, 1.8 times fewer
+// field evaluations, the same solution.
 #pragma once
 
 #include <vector>
@@ -30,8 +41,12 @@
 
 namespace odemag {
 
+// The Newton variable of solve_bh_lattice: the cells' H (4) or b = H + M (5).
+enum class BhNewtonVariable { field, flux_density };
+
 struct BhSolveOptions {
   double tolerance = 1e-7;   // on |G| / |w f(H)| (2-norms over all cells)
+  BhNewtonVariable variable = BhNewtonVariable::flux_density;
   int max_newton = 60;
   // GMRES stops at the relative residual eta of the Newton system, eta by
   // Eisenstat and Walker's choice 2 between min_forcing and forcing.
@@ -58,5 +73,9 @@ BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, 
 
 // f(H) of (3) for one cell, and its Jacobian dM/dH (six components), times w.
 Vec3 bh_cell_law(const BhCurve& curve, double w, const Vec3& H, double jacobian[6]);
+
+// The same law in b = H + M (5): M and H (A/m) of the cell whose b is given,
+// and dM/db (six components).
+Vec3 bh_flux_cell_law(const BhCurve& curve, double w, const Vec3& b, Vec3& H, double jacobian[6]);
 
 }  // namespace odemag

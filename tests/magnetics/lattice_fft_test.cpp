@@ -8,6 +8,7 @@
 
 #include "magnetics/bh_lattice_solve.h"
 #include "magnetics/constants.h"
+#include "magnetics/kernels.h"
 #include "magnetics/lattice_fft.h"
 #include "magnetics/rng.h"
 
@@ -104,20 +105,50 @@ TEST(LatticeFft, LayersOfSmallerCellsEqualTheDenseSums) {
   EXPECT_THROW(LatticeDemag(cell, {bad}), std::invalid_argument);
 }
 
+// The cell law in b = H + M (bh_lattice_solve.h (5)) inverts b = H + w f(H):
+// from H, b = H + w f(H) gives back H and M = w f(H), and dM/db is the
+// derivative of M(b) (central differences), at cells cut to w = 0.6 too.
+TEST(BhLatticeSolve, FluxDensityCellLawInvertsTheCurve) {
+  const BhCurve curve({{0.0, 0.0}, {100.0, 0.5}, {300.0, 1.2}, {1000.0, 1.5}, {1e4, 1.8}});
+  for (const double w : {1.0, 0.6}) {
+    for (const Vec3& H : {Vec3{0, 0, 20.0}, Vec3{150.0, -80.0, 40.0}, Vec3{-700.0, 300.0, 900.0}, Vec3{0, 3e4, 1e5}}) {
+      double unused[6], J[6];
+      const Vec3 M = bh_cell_law(curve, w, H, unused);
+      Vec3 H_back;
+      const Vec3 M_back = bh_flux_cell_law(curve, w, H + M, H_back, J);
+      EXPECT_LT(norm(H_back - H), 1e-12 * norm(H + M)) << w << " " << H.x << " " << H.y << " " << H.z;
+      EXPECT_LT(norm(M_back - M), 1e-12 * norm(H + M)) << w << " " << H.x << " " << H.y << " " << H.z;
+      for (int k = 0; k < 3; ++k) {
+        Vec3 db{};
+        (&db.x)[k] = 1e-6 * norm(H + M);
+        Vec3 Hp, Hm;
+        const Vec3 dM = (bh_flux_cell_law(curve, w, H + M + db, Hp, unused) -
+                         bh_flux_cell_law(curve, w, H + M - db, Hm, unused)) / (2.0 * (&db.x)[k]);
+        const Vec3 column = symmetric_times(J, k == 0 ? Vec3{1, 0, 0} : k == 1 ? Vec3{0, 1, 0} : Vec3{0, 0, 1});
+        EXPECT_LT(norm(dM - column), 1e-6) << w << " " << H.x << " " << H.y << " " << H.z << " column " << k;
+      }
+    }
+  }
+}
+
 // One soft cube of 4^3 cells in a uniform field: the solve converges, and the
 // mean M sits on the curve at the mean internal field (a cube's mean field is
-// H_A - N M with N about 1/3; checked as M = M(|H|) cell by cell).
+// H_A - N M with N about 1/3; checked as M = M(|H|) cell by cell), in both
+// Newton variables (the field H and the default b = H + M).
 TEST(BhLatticeSolve, SoftCubeConvergesOntoTheCurve) {
   const BhCurve curve({{0.0, 0.0}, {100.0, 0.5}, {300.0, 1.2}, {1000.0, 1.5}, {1e4, 1.8}});
   LatticeGrid g;
   g.n = {4, 4, 4};
   g.mask.assign(64, 1);
   const LatticeDemag demag({1e-3, 1e-3, 1e-3}, {g});
+  for (const BhNewtonVariable variable : {BhNewtonVariable::field, BhNewtonVariable::flux_density})
   for (const double Ha : {1e3, 3e5, 2e6}) {
     const std::vector<double> fill(64, 1.0);
     const std::vector<Vec3> source(64, Vec3{0.0, 0.0, Ha});
     std::vector<Vec3> M(64);
-    const BhSolveReport report = solve_bh_lattice(demag, curve, fill, source, M);
+    BhSolveOptions options;
+    options.variable = variable;
+    const BhSolveReport report = solve_bh_lattice(demag, curve, fill, source, M, options);
     EXPECT_TRUE(report.converged) << Ha;
     // Field evaluations: one per GMRES iteration, at least one residual per
     // Newton step and the initial one; at most one more per GMRES restart
