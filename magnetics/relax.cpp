@@ -243,6 +243,40 @@ std::vector<Vec3> initial_iterate(OuterLoop& l, RelaxReport& report) {
   return fixed_plus_responsive(l);
 }
 
+// Predicted warm start (docs/model.md): the first iterate h, the fixed field
+// plus the field of the warm-start magnetization, lacks the magnetization's
+// change over this relaxation. Where the last two relaxations changed a
+// cell's applied field alike (to half the last change: a steady drift, as
+// of a body moving smoothly), this one starts from h plus the last change.
+// Elsewhere from h: at rest the changes are the solve's own error (added
+// again, a cell would take more iterations and move within the tolerance),
+// and a jump (a cold start, a coil switched, a ball snapping onto another)
+// added again would push the cell's moments twice as far.
+constexpr double kSteadyChange = 0.5;
+std::vector<Vec3> predicted_start(const OuterLoop& l, const std::vector<Vec3>& h) {
+  std::vector<Vec3> x = h;
+  if (!l.o.predict_warm_start) return x;
+  for (size_t i = 0; i < h.size(); ++i) {
+    const Vec3& last = l.state.relaxation_change[l.cells[i]];
+    const Vec3& before = l.state.previous_relaxation_change[l.cells[i]];
+    if (norm(last - before) <= kSteadyChange * norm(last)) x[i] += last;
+  }
+  return x;
+}
+
+// What this relaxation added to its first iterate h, kept for the next ones'
+// predicted start; zero at every other cell, and everywhere when it did not
+// converge (a failed relaxation predicts nothing).
+void remember_relaxation_change(const OuterLoop& l, const std::vector<Vec3>& h, bool converged) {
+  MagneticState& s = l.state;
+  std::vector<Vec3> last(s.relaxation_change.size());
+  if (converged)
+    for (size_t i = 0; i < h.size(); ++i) last[l.cells[i]] = l.H_A[l.cells[i]] - h[i];
+  s.previous_relaxation_change =
+      converged ? std::move(s.relaxation_change) : std::vector<Vec3>(last.size());
+  s.relaxation_change = std::move(last);
+}
+
 std::vector<double> flatten(const std::vector<Vec3>& h) {
   std::vector<double> x(3 * h.size());
   for (size_t i = 0; i < h.size(); ++i)
@@ -426,7 +460,7 @@ RelaxReport relax_two_level(const MagneticModel& model, MagneticState& state, co
               std::vector<Vec3>(model.cell_count()), std::vector<Vec3>(model.cell_count())};
   l.local.single_step = false;
   const std::vector<Vec3> h = initial_iterate(l, report);
-  std::vector<double> x = flatten(h), f(x.size());
+  std::vector<double> x = flatten(predicted_start(l, h)), f(x.size());
   SafeguardedAnderson anderson(o.anderson_depth, o.mixing, cell_weights(l, h));
   const std::vector<ResponseBlock> blocks = response_blocks(l, h);
   std::vector<double> g;
@@ -453,6 +487,7 @@ RelaxReport relax_two_level(const MagneticModel& model, MagneticState& state, co
   }
   report.iterations = std::min(report.iterations, o.max_iterations);
   for (int c : cells) state.applied_field[c] = l.H_A[c];
+  remember_relaxation_change(l, h, report.converged);
   return report;
 }
 
@@ -497,9 +532,14 @@ RelaxReport solve(const MagneticModel& model, MagneticState& state, const RelaxO
     nothing.converged = true;
     return nothing;
   }
+  if (o.scheme == RelaxScheme::two_level && o.mutual_induction)
+    return relax_two_level(model, state, o, backend, cells, H_fixed);
+  // The other schemes predict nothing for a later two-level relaxation.
+  std::fill(state.relaxation_change.begin(), state.relaxation_change.end(), Vec3{});
+  std::fill(state.previous_relaxation_change.begin(), state.previous_relaxation_change.end(),
+            Vec3{});
   if (o.scheme == RelaxScheme::paper) return relax_paper(model, state, o, backend, cells, H_fixed);
-  if (!o.mutual_induction) return relax_one_pass(model, state, o, backend, cells, H_fixed);
-  return relax_two_level(model, state, o, backend, cells, H_fixed);
+  return relax_one_pass(model, state, o, backend, cells, H_fixed);
 }
 
 // docs/architecture.md "One magnetic step", 4: per-body forces and torques.

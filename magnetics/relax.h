@@ -59,6 +59,11 @@ struct RelaxOptions {
   // (magnetics/body_response.h, docs/model.md "Block preconditioner").
   // false: Anderson on the plain residual, as before.
   bool precondition_bodies = true;
+  // The outer loop starts from the warm start's applied field plus what the
+  // last relaxation added to it, where the last two relaxations added alike
+  // (MagneticState::relaxation_change, docs/model.md "Predicted warm
+  // start"). false: from the warm start's field, as before.
+  bool predict_warm_start = true;
   LocalRelaxOptions local;
   // Called after every outer iteration with the report so far (iterations,
   // residual_history): progress lines of a long `odemag solve`. Empty: none.

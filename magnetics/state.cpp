@@ -9,6 +9,9 @@ namespace odemag {
 void reset_moments(const MagneticModel& model, MagneticState& state, int b) {
   state.last_solve.valid = false;
   const MagneticBody& body = model.body(b);
+  for (int i = 0; i < body.cell_count(); ++i)
+    state.relaxation_change[body.first_cell + i] =
+        state.previous_relaxation_change[body.first_cell + i] = {};
   if (body.kind != CellKind::soft) return;
   for (int i = 0; i < body.cell_count(); ++i) {
     const int c = body.first_cell + i;
@@ -34,6 +37,8 @@ void extend_state(const MagneticModel& model, MagneticState& state) {
   state.cell_position.resize(model.cell_count());
   state.magnetization.resize(model.cell_count());
   state.applied_field.resize(model.cell_count());
+  state.relaxation_change.resize(model.cell_count());
+  state.previous_relaxation_change.resize(model.cell_count());
   state.llg_history.resize(model.cell_count(), 0);
   state.noise_counter.resize(model.cell_count(), 0);
   state.moments.resize(model.moment_count());

@@ -40,6 +40,13 @@ struct MagneticState {
   std::vector<Vec3> cell_position;   // world, m
   std::vector<Vec3> magnetization;   // world, A/m
   std::vector<Vec3> applied_field;   // H_A = H_E + H_exo at responsive cells, world, A/m
+  // What the last two-level relaxation added to H_A after its first iterate
+  // (the field of the magnetization change it found), and what the one
+  // before it added; world, A/m; zero where a relaxation did not reach or
+  // did not converge. Where the two agree (a steady drift) the next
+  // relaxation starts from its first iterate plus the last
+  // (magnetics/relax.cpp, docs/model.md "Predicted warm start").
+  std::vector<Vec3> relaxation_change, previous_relaxation_change;
   std::vector<uint8_t> llg_history;  // Hc^(i-1) is valid (paper Algorithm 1 scheme)
   std::vector<uint64_t> noise_counter;
 

@@ -138,7 +138,9 @@ void MagneticForces::restore_state(const SavedMagneticState& saved) {
                nm = static_cast<size_t>(model_.moment_count());
   const bool sized = s.pose.size() == nb && s.active.size() == nb && s.magnetization_scale.size() == nb &&
                      s.force.size() == nb && s.torque.size() == nb && s.cell_position.size() == nc &&
-                     s.magnetization.size() == nc && s.applied_field.size() == nc && s.llg_history.size() == nc &&
+                     s.magnetization.size() == nc && s.applied_field.size() == nc &&
+                     s.relaxation_change.size() == nc && s.previous_relaxation_change.size() == nc &&
+                     s.llg_history.size() == nc &&
                      s.noise_counter.size() == nc && s.moments.size() == nm && s.moment_hc_prev.size() == nm;
   if (!sized)
     throw std::invalid_argument(where + "the saved state's arrays do not match its " + std::to_string(nb) +

@@ -73,6 +73,13 @@
 // by ~2.5e-6 of a close pair's force). Every scene with sphere pairs
 // moved (ball_chain, thin_iron_plate, nail_and_balls); iron_plate, without
 // them, kept its hash. Outcomes in docs/scenes.md "stop 29".
+// Re-pinned (stop 32) for the predicted warm start: the outer loop starts
+// from the warm start plus the last relaxation's change of a cell's applied
+// field where the last two relaxations changed it alike (magnetics/relax.cpp,
+// docs/model.md "Predicted warm start"). The same fixed points to the
+// tolerance, reached from other first iterates in fewer iterations, so every
+// scene's iterates and rounding moved (all four). Outcomes in docs/scenes.md
+// "stop 32".
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -133,10 +140,10 @@ struct Case {
 };
 
 const Case kCases[] = {
-    {"ball_chain", 1.5, 0x6882c506e7d91dcdULL},
-    {"iron_plate", 1.7, 0xa762fef82f9adb80ULL},
-    {"thin_iron_plate", 1.0, 0xb2b1f737582e0fbfULL},
-    {"nail_and_balls", 3.2, 0x401f76e350eb60cfULL},
+    {"ball_chain", 1.5, 0xf94d936026dd635fULL},
+    {"iron_plate", 1.7, 0x44c3dd2721c38b13ULL},
+    {"thin_iron_plate", 1.0, 0xbbcbd257f33ce9dcULL},
+    {"nail_and_balls", 3.2, 0xd0b4a66f5897858eULL},
 };
 
 // Set by tests/engine/CMakeLists.txt for a Release build with

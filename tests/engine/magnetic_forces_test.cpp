@@ -505,6 +505,9 @@ TEST(MagneticForcesState, RestoreIntoOtherMagneticsThrows) {
   SavedMagneticState edited = saved;  // arrays that do not fit
   edited.state.moments.pop_back();
   EXPECT_THROW(a.magnetics.restore_state(edited), std::invalid_argument);
+  SavedMagneticState unpredicted = saved;  // the predicted warm start's changes missing
+  unpredicted.state.previous_relaxation_change.clear();
+  EXPECT_THROW(a.magnetics.restore_state(unpredicted), std::invalid_argument);
   EXPECT_NO_THROW(a.magnetics.restore_state(saved));
 }
 
