@@ -935,6 +935,8 @@ const KeyTable<SolverSettings> kSolverKeys = {
      .doc = {"bool", "", "`true`"}},
     {.name = "precondition_bodies", .check = Check::boolean, .slot = SLOT(relax.precondition_bodies),
      .doc = {"bool", "", "`true`"}},
+    {.name = "predict_warm_start", .check = Check::boolean, .slot = SLOT(relax.predict_warm_start),
+     .doc = {"bool", "", "`true`"}},
     {.name = "graded_cells", .check = Check::boolean, .slot = SLOT(graded_cells),
      .doc = {"bool", "", "`false`"}},
     {.name = "backend", .check = Check::choice, .slot = SLOT(backend), .words = {"cpu", "cuda", "auto"},

@@ -194,6 +194,45 @@ TEST_F(Cli, PreconditionBodiesKeyKeepsTheSolutionAndCutsIterations) {
   EXPECT_NE(bad.err.find("solver.precondition_bodies"), std::string::npos) << bad.err;
 }
 
+// solver.predict_warm_start: three anisotropic steel balls falling together
+// towards a magnet (a steady drift of every cell's field) take fewer outer
+// iterations with the predicted warm start (docs/model.md "Predicted warm
+// start"; that it reaches the same magnetization is
+// tests/magnetics/warm_start_test.cpp's); a value that is not a bool is
+// refused naming the key.
+TEST_F(Cli, PredictWarmStartKeyCutsIterationsOfASteadyFall) {
+  const auto scene = [&](const std::string& on) {
+    return write(on + ".json", std::string(R"({
+      "materials": {
+        "magnet": {"type": "permanent", "magnetization": [0, 0, 900000]},
+        "steel": {"type": "soft", "saturation": 1.6e6, "susceptibility": 1000, "anisotropy_field": 3.2e5,
+                  "moments_per_cell": 8}},
+      "bodies": [
+        {"name": "magnet", "shape": {"box": [0.02, 0.02, 0.01]}, "material": "magnet", "position": [0, 0, 0.005],
+         "fixed": true},
+        {"name": "a", "shape": {"sphere": 0.005}, "material": "steel", "position": [0, 0, 0.06]},
+        {"name": "b", "shape": {"sphere": 0.005}, "material": "steel", "position": [0.0005, 0, 0.0702]},
+        {"name": "c", "shape": {"sphere": 0.005}, "material": "steel", "position": [0.001, 0, 0.0804]}],
+      "simulation": {"time_step": 0.001, "duration": 0.05, "ground": false},
+      "solver": {"tolerance": 1e-6, "predict_warm_start": )") + on + "}}");
+  };
+  json summary[2];
+  for (int on = 0; on < 2; ++on) {
+    const fs::path out = dir_ / (on ? "on" : "off");
+    const ProgramRun r = odemag("run " + shell_quote(scene(on ? "true" : "false").string()) + " --out " +
+                                shell_quote(out.string()) + " --frames no --quiet yes --backend cpu --threads 1");
+    ASSERT_EQ(r.status, 0) << r.err;
+    summary[on] = json::parse(read_file(out / "summary.json"));
+  }
+  const double plain = summary[0]["iterations"]["total"].get<double>();
+  const double predicted = summary[1]["iterations"]["total"].get<double>();
+  std::printf("outer iterations over 0.05 s: %g predicted, %g plain\n", predicted, plain);
+  EXPECT_LE(predicted, 0.8 * plain);
+  const ProgramRun bad = odemag("solve " + shell_quote(scene("1").string()));
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("solver.predict_warm_start"), std::string::npos) << bad.err;
+}
+
 // A B-H curve material: `solve` runs it on the CPU backend with "auto" (the
 // default) and refuses "cuda" with exit 2 naming the material's key; the
 // ball's moment is along the field and below the saturated moment.
