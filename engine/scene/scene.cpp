@@ -959,6 +959,15 @@ const KeyTable<ContactSettings> kContactKeys = {
      .doc = {"number", "m", "`1e-5`"}},
 };
 
+const KeyTable<SleepSettings> kSleepKeys = {
+    {.name = "time", .check = Check::non_negative, .slot = SLOT(time),
+     .doc = {"number", "s", "`0`"}},
+    {.name = "speed", .check = Check::positive, .slot = SLOT(speed), .bound = kSpeed,
+     .doc = {"number", "m/s", "`0.005`"}},
+    {.name = "wake_force", .check = Check::positive, .slot = SLOT(wake_force),
+     .doc = {"number", "", "`0.05`"}},
+};
+
 const KeyTable<SimulationSettings> kSimulationKeys = {
     {.name = "time_step", .check = Check::positive, .slot = SLOT(time_step),
      .doc = {"number", "s", "`0.004`"}},
@@ -976,6 +985,11 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
     {.name = "contact",
      .read = [](const SceneReader& r, const json& x, const std::string& p, SimulationSettings& s) {
        read_object(r, x, p, kContactKeys, s.contact);
+     },
+     .doc = {"object", "", ""}},
+    {.name = "sleep",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SimulationSettings& s) {
+       read_object(r, x, p, kSleepKeys, s.sleep);
      },
      .doc = {"object", "", ""}},
     {.name = "linear_damping", .check = Check::in_range, .slot = SLOT(linear_damping), .lo = 0.0, .hi = 1.0,
@@ -1474,6 +1488,7 @@ std::vector<SceneKeyDoc> scene_key_docs() {
   add_key_docs(docs, "solver", kSolverKeys);
   add_key_docs(docs, "simulation", kSimulationKeys);
   add_key_docs(docs, "simulation.contact", kContactKeys);
+  add_key_docs(docs, "simulation.sleep", kSleepKeys);
   for (const EventAction& a : kEventActions)
     add_key_docs(docs, std::string("timeline[].") + a.action, *a.keys);
   add_key_docs(docs, "timeline[].keys[]", kKeyframeKeys);

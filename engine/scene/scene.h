@@ -83,6 +83,15 @@ struct ContactSettings {
   double rolling_friction = 1e-5;
 };
 
+// Sleeping bodies (docs/simulation.md "Sleeping bodies"): a group of bodies
+// touching each other that has stayed slow for `time` is taken out of ODE's
+// step until something wakes it.
+struct SleepSettings {
+  double time = 0.0;           // s below `speed` before a contact group sleeps; 0: never
+  double speed = 0.005;        // m/s: |v| + |omega| r, r the body's bounding radius
+  double wake_force = 0.05;    // wake when the applied force moves this fraction of the weight
+};
+
 struct SimulationSettings {
   double time_step = 0.004;   // rigid step, s
   double duration = 2.0;      // s
@@ -97,6 +106,7 @@ struct SimulationSettings {
   bool ground = true;         // a ground plane z = ground_height
   double ground_height = 0.0;
   ContactSettings contact;
+  SleepSettings sleep;
   double linear_damping = 0.0;
   double angular_damping = 0.0;
   // A rigid step is split into substeps, each with its own magnetic forces

@@ -39,7 +39,8 @@ constexpr long kExactSolverBodies = 32;
 
 }  // namespace
 
-RigidWorld::RigidWorld(const SceneDescription& scene) : contact_(scene.simulation.contact) {
+RigidWorld::RigidWorld(const SceneDescription& scene)
+    : contact_(scene.simulation.contact), sleep_(scene.simulation.sleep), gravity_(norm(scene.gravity)) {
   const long dynamic = std::count_if(scene.bodies.begin(), scene.bodies.end(),
                                      [](const BodyDescription& b) { return !b.fixed; });
   const std::string& solver = scene.simulation.contact_solver;
@@ -72,12 +73,15 @@ RigidWorld::RigidWorld(const SceneDescription& scene) : contact_(scene.simulatio
     if (const auto* s = std::get_if<Sphere>(&d.shape)) {
       dMassSetSphere(&m, d.density, s->radius);
       b.geom = dCreateSphere(space_, s->radius + skin);
+      b.radius = s->radius;
     } else if (const auto* x = std::get_if<Box>(&d.shape)) {
       dMassSetBox(&m, d.density, x->size.x, x->size.y, x->size.z);
       b.geom = dCreateBox(space_, x->size.x + 2 * skin, x->size.y + 2 * skin, x->size.z + 2 * skin);
+      b.radius = norm(half);
     } else if (const auto* c = std::get_if<Cylinder>(&d.shape)) {
       dMassSetCylinder(&m, d.density, 3, c->radius, c->length);
       b.geom = dCreateCylinder(space_, c->radius + skin, c->length + 2 * skin);
+      b.radius = std::hypot(c->radius, 0.5 * c->length);
     }
     dBodySetMass(b.body, &m);
     b.mass = m.mass;
@@ -101,6 +105,7 @@ RigidWorld::RigidWorld(const SceneDescription& scene) : contact_(scene.simulatio
 }
 
 void RigidWorld::add_joint(const SceneDescription& scene, const JointDescription& j) {
+  for (const std::string& name : j.bodies) bodies_[scene.find_body(name)].jointed = true;
   dBodyID a = bodies_[scene.find_body(j.bodies[0])].body;
   dBodyID b = j.bodies.size() > 1 ? bodies_[scene.find_body(j.bodies[1])].body : nullptr;
   const Vec3 &p = j.anchor, &n = j.axis;
@@ -154,8 +159,13 @@ int RigidWorld::index_of(dBodyID body) const {
 }
 
 void RigidWorld::set_enabled(int i, bool enabled) {
+  // A body that appears or goes may change what holds the others up.
+  for (int k = 0; k < body_count(); ++k)
+    if (bodies_[k].sleeping) wake(k);
   Body& b = bodies_[i];
   b.enabled = enabled;
+  b.sleeping = false;
+  b.idle = 0.0;
   if (enabled) {
     dBodyEnable(b.body);
     dGeomEnable(b.geom);
@@ -168,6 +178,7 @@ void RigidWorld::set_enabled(int i, bool enabled) {
 void RigidWorld::set_kinematic(int i, bool kinematic) {
   Body& b = bodies_[i];
   if (b.kinematic == kinematic) return;
+  if (b.sleeping) wake(i);
   b.kinematic = kinematic;
   if (kinematic) {
     dBodySetKinematic(b.body);
@@ -177,6 +188,7 @@ void RigidWorld::set_kinematic(int i, bool kinematic) {
 }
 
 void RigidWorld::set_kinematic_state(int i, const BodyPose& pose, const Vec3& v, const Vec3& w) {
+  if (bodies_[i].sleeping) wake(i);
   dBodyID body = bodies_[i].body;
   dBodySetPosition(body, pose.position.x, pose.position.y, pose.position.z);
   dMatrix3 R;
@@ -194,8 +206,14 @@ void RigidWorld::update_forces(double time, double dt) {
 }
 
 void RigidWorld::integrate(double h) {
+  // Sleeping bodies are enabled while the accumulators add their forces, so
+  // that a change of those forces can wake them (wake_on_force_change).
+  for (Body& b : bodies_)
+    if (b.sleeping) dBodyEnable(b.body);
   for (ForceAccumulator* a : accumulators_) a->add_forces();
-  for (Body& b : bodies_) b.in_contact = false, b.contacts = 0;
+  for (Body& b : bodies_) b.in_contact = false, b.contacts = 0, b.touches_kinematic = false;
+  touching_.clear();
+  if (sleep_.time > 0.0) wake_on_force_change();
   // ODE's random numbers (dWorldQuickStep reorders constraints randomly) come
   // from one seed per process: each world keeps its own sequence, so a run
   // does not depend on the worlds stepped before it in the same process (a
@@ -203,6 +221,7 @@ void RigidWorld::integrate(double h) {
   const unsigned long process_seed = dRandGetSeed();
   dRandSetSeed(random_seed_);
   dSpaceCollide(space_, this, &RigidWorld::near_callback);
+  create_contact_joints();
   // ODE damps once per step it takes: scaled so that the substeps of a rigid
   // step damp together by the scene's factor, whatever their count (each
   // body keeps the values it was given; set again when h changes).
@@ -222,6 +241,7 @@ void RigidWorld::integrate(double h) {
     dWorldQuickStep(world_, h);
   }
   dJointGroupEmpty(contacts_);
+  if (sleep_.time > 0.0) update_sleep(h);
   random_seed_ = dRandGetSeed();
   dRandSetSeed(process_seed);
 }
@@ -256,13 +276,19 @@ void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
   if (self->has_joints_ && ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
   dContact contact[kMaxContacts];
   const int n = dCollide(a, b, kMaxContacts, &contact[0].geom, sizeof(dContact));
-  if (n > 0) {
-    for (dBodyID body : {ba, bb})
-      if (body) {
-        Body& touched = self->bodies_[self->index_of(body)];
-        touched.in_contact = true;
-        touched.contacts += n;
-      }
+  if (n == 0) return;
+  for (dBodyID body : {ba, bb})
+    if (body) {
+      Body& touched = self->bodies_[self->index_of(body)];
+      touched.in_contact = true;
+      touched.contacts += n;
+    }
+  if (a_moves && b_moves) {
+    self->touching_.emplace_back(self->index_of(ba), self->index_of(bb));
+  } else if (ba && bb) {  // one of them kinematic: it may move, so the other is awake
+    const int moving = self->index_of(a_moves ? ba : bb);
+    self->bodies_[moving].touches_kinematic = true;
+    if (self->bodies_[moving].sleeping) self->wake(moving);
   }
   const double skins = self->skin_of(a) + self->skin_of(b);
   for (int i = 0; i < n; ++i) {
@@ -275,8 +301,101 @@ void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
     s.bounce_vel = 0.01;
     s.soft_cfm = self->contact_.softness;
     s.soft_erp = self->contact_.erp;
-    dJointID j = dJointCreateContact(self->world_, self->contacts_, &contact[i]);
-    dJointAttach(j, ba, bb);
+    self->found_.push_back({contact[i], ba, bb});
+  }
+}
+
+void RigidWorld::create_contact_joints() {
+  if (sleep_.time > 0.0) {
+    // A sleeping body that touches nothing any more wakes (it would hang in
+    // the air), and one that a faster body runs into wakes before the step,
+    // so that the impact moves it (asleep it would stop the other like a wall).
+    for (int i = 0; i < body_count(); ++i)
+      if (bodies_[i].sleeping && !bodies_[i].in_contact) wake(i);
+    for (const auto& [a, b] : touching_) {
+      if (bodies_[a].sleeping != bodies_[b].sleeping && speed(bodies_[a].sleeping ? b : a) > sleep_.speed)
+        wake(bodies_[a].sleeping ? a : b);
+    }
+  }
+  // A sleeping body is a fixed support for the bodies awake around it.
+  auto sleeps = [this](dBodyID b) { return b && bodies_[index_of(b)].sleeping; };
+  for (const FoundContact& f : found_) {
+    const bool a_sleeps = sleeps(f.a), b_sleeps = sleeps(f.b);
+    if ((a_sleeps || !f.a) && (b_sleeps || !f.b)) continue;  // neither moves
+    dJointID j = dJointCreateContact(world_, contacts_, &f.contact);
+    dJointAttach(j, a_sleeps ? nullptr : f.a, b_sleeps ? nullptr : f.b);
+  }
+  found_.clear();
+}
+
+double RigidWorld::speed(int i) const {
+  const Body& b = bodies_[i];
+  const dReal* v = dBodyGetLinearVel(b.body);
+  const dReal* w = dBodyGetAngularVel(b.body);
+  return norm(Vec3{v[0], v[1], v[2]}) + norm(Vec3{w[0], w[1], w[2]}) * b.radius;
+}
+
+int RigidWorld::sleeping_count() const {
+  return static_cast<int>(std::count_if(bodies_.begin(), bodies_.end(), [](const Body& b) { return b.sleeping; }));
+}
+
+void RigidWorld::wake(int i) {
+  Body& b = bodies_[i];
+  b.sleeping = false;
+  b.idle = 0.0;
+  dBodyEnable(b.body);
+}
+
+void RigidWorld::wake_on_force_change() {
+  for (int i = 0; i < body_count(); ++i) {
+    Body& b = bodies_[i];
+    const dReal* f = dBodyGetForce(b.body);
+    const dReal* t = dBodyGetTorque(b.body);
+    b.force = {f[0], f[1], f[2]};
+    b.torque = {t[0], t[1], t[2]};
+    if (!b.sleeping) continue;
+    // The scale: the body's weight, and its weight's torque at its radius.
+    const double allowed = sleep_.wake_force * b.mass * gravity_;
+    if (norm(b.force - b.rest_force) > allowed || norm(b.torque - b.rest_torque) > allowed * b.radius) {
+      wake(i);
+    } else {
+      dBodySetForce(b.body, 0, 0, 0);
+      dBodySetTorque(b.body, 0, 0, 0);
+      dBodyDisable(b.body);
+    }
+  }
+}
+
+void RigidWorld::update_sleep(double h) {
+  const int n = body_count();
+  std::vector<double> speeds(n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    Body& b = bodies_[i];
+    if (b.sleeping) continue;
+    speeds[i] = speed(i);
+    const bool candidate = b.enabled && !b.kinematic && !b.jointed && b.in_contact && !b.touches_kinematic;
+    b.idle = candidate && speeds[i] <= sleep_.speed ? b.idle + h : 0.0;
+  }
+  // A sleeping body wakes when a body touching it moves faster than the
+  // sleep speed; a body falls asleep only among slow neighbours.
+  std::vector<char> fast_neighbour(n, 0);
+  for (const auto& [a, b] : touching_) {
+    if (speeds[b] > sleep_.speed) fast_neighbour[a] = 1;
+    if (speeds[a] > sleep_.speed) fast_neighbour[b] = 1;
+  }
+  for (int i = 0; i < n; ++i) {
+    Body& b = bodies_[i];
+    if (b.sleeping) {
+      if (fast_neighbour[i]) wake(i);
+      continue;
+    }
+    if (b.idle < sleep_.time || fast_neighbour[i]) continue;
+    b.sleeping = true;
+    b.rest_force = b.force;
+    b.rest_torque = b.torque;
+    dBodySetLinearVel(b.body, 0, 0, 0);
+    dBodySetAngularVel(b.body, 0, 0, 0);
+    dBodyDisable(b.body);
   }
 }
 

@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/ode/exact_step.h"
@@ -54,6 +55,13 @@ class RigidWorld {
   void update_forces(double time, double dt);
   void integrate(double h);
 
+  // Whether the body sleeps (docs/simulation.md "Sleeping bodies"): taken
+  // out of ODE's step, at rest, until its applied force or torque moves by
+  // SleepSettings::wake_force of its weight, a moving body touches it, or
+  // the time line moves it.
+  bool sleeping(int i) const { return bodies_[i].sleeping; }
+  int sleeping_count() const;
+
   // Whether the body touched something in the last integrate().
   bool in_contact(int i) const { return bodies_[i].in_contact; }
   // Its contact points in the last integrate() (ODE's dCollide gives up to 8 per pair).
@@ -83,11 +91,30 @@ class RigidWorld {
     bool in_contact = false;
     int contacts = 0;
     double skin = 0.0;  // collision geometry enlarged by this much, m
+    // Sleeping bodies (docs/simulation.md "Sleeping bodies").
+    double radius = 0.0;       // bounding radius of the shape, m
+    bool jointed = false;      // held by a scene joint: never sleeps
+    bool sleeping = false;
+    bool touches_kinematic = false;  // in the last integrate()
+    double idle = 0.0;         // s below the sleep speed, in contact
+    Vec3 force, torque;        // applied (accumulators) in the last integrate()
+    Vec3 rest_force, rest_torque;  // applied when it fell asleep
   };
   // An ODE joint of the scene (docs/scene-format.md "joints"), in the world frame.
   void add_joint(const SceneDescription& scene, const JointDescription& joint);
   int index_of(dBodyID body) const;
+  // Collects the contacts of a geom pair (found_); create_contact_joints
+  // then wakes the sleeping bodies a faster body runs into and makes ODE's
+  // contact joints.
   static void near_callback(void* data, dGeomID a, dGeomID b);
+  void create_contact_joints();
+  double speed(int i) const;  // |v| + |omega| r, m/s
+  void wake(int i);
+  // Before the step: wakes sleeping bodies whose applied force or torque moved.
+  void wake_on_force_change();
+  // After the step: notes bodies ODE's islands woke, and puts to sleep the
+  // contact groups whose every body has been slow for SleepSettings::time.
+  void update_sleep(double h);
   double skin_of(dGeomID geom) const;
 
   dWorldID world_ = nullptr;
@@ -98,6 +125,15 @@ class RigidWorld {
   std::vector<Body> bodies_;
   std::vector<ForceAccumulator*> accumulators_;
   ContactSettings contact_;
+  SleepSettings sleep_;
+  double gravity_ = 0.0;  // |g|, m/s^2
+  // Pairs of dynamic bodies in contact in the last integrate().
+  std::vector<std::pair<int, int>> touching_;
+  struct FoundContact {
+    dContact contact;
+    dBodyID a, b;  // nullptr: the ground
+  };
+  std::vector<FoundContact> found_;  // by near_callback, until create_contact_joints
   bool exact_solver_ = false;
   std::unique_ptr<ExactStep> exact_step_;  // with the exact solver
   std::vector<dBodyID> ode_bodies_;        // every body, for ExactStep

@@ -138,7 +138,8 @@ void Simulation::apply_timeline(double dt) {
 int Simulation::substeps_needed(double dt) {
   for (int b = 0; b < world_->body_count(); ++b) {
     SubstepMotion& m = substep_motion_[b];
-    m.free = !world_->kinematic(b) && world_->enabled(b);
+    // A sleeping body does not move (docs/simulation.md "Sleeping bodies").
+    m.free = !world_->kinematic(b) && world_->enabled(b) && !world_->sleeping(b);
     if (!m.free) continue;
     m.mass = world_->mass(b);
     m.velocity = world_->velocity(b);
@@ -211,6 +212,7 @@ void Simulation::step() {
     update_forces(time_ + done, dt / substeps_, relax_every_substep);
     update_substeps(dt, false, record);
   }
+  record.sleeping = world_->sleeping_count();
   records_.push_back(record);
   time_ += dt;
   ++steps_;

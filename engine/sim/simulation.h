@@ -33,6 +33,7 @@ struct StepRecord {
   int skipped = 0;           // substeps whose magnetic step was skipped (solver.skip_unchanged)
   bool converged = true;
   double residual = 0.0;
+  int sleeping = 0;          // bodies asleep at the step's end (SleepSettings)
 };
 
 class Simulation {

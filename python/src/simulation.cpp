@@ -175,6 +175,7 @@ class PySimulation {
     d["skipped"] = copied_array<int>(column(&StepRecord::skipped));
     d["converged"] = copied_array<bool>(column(&StepRecord::converged));
     d["residual"] = double_array(column(&StepRecord::residual));
+    d["sleeping"] = copied_array<int>(column(&StepRecord::sleeping));
     return d;
   }
 

@@ -233,6 +233,35 @@ TEST_F(Cli, PredictWarmStartKeyCutsIterationsOfASteadyFall) {
   EXPECT_NE(bad.err.find("solver.predict_warm_start"), std::string::npos) << bad.err;
 }
 
+// simulation.sleep: balls resting on the ground fall asleep in `odemag run`
+// (summary.json "sleeping": bodies asleep at each step's end; the rules are
+// tests/engine/sleep_test.cpp's), none without the key; a negative time is
+// refused naming the key.
+TEST_F(Cli, SleepKeyPutsRestingBallsToSleep) {
+  const auto scene = [&](const std::string& name, const std::string& sleep) {
+    return write(name + ".json", std::string(R"({
+      "materials": {"steel": {"type": "soft", "saturation": 1.6e6, "susceptibility": 1000}},
+      "bodies": [
+        {"name": "a", "shape": {"sphere": 0.005}, "material": "steel", "position": [0, 0, 0.005]},
+        {"name": "b", "shape": {"sphere": 0.005}, "material": "steel", "position": [0.01, 0, 0.005]}],
+      "simulation": {"time_step": 0.001, "duration": 0.1)") + sleep + "}}");
+  };
+  json summary[2];
+  for (int on = 0; on < 2; ++on) {
+    const fs::path out = dir_ / (on ? "asleep" : "awake");
+    const fs::path file = scene(on ? "asleep" : "awake", on ? R"(, "sleep": {"time": 0.02})" : "");
+    const ProgramRun r = odemag("run " + shell_quote(file.string()) + " --out " + shell_quote(out.string()) +
+                                " --frames no --quiet yes --backend cpu --threads 1");
+    ASSERT_EQ(r.status, 0) << r.err;
+    summary[on] = json::parse(read_file(out / "summary.json"));
+  }
+  EXPECT_EQ(summary[0]["sleeping"]["max"].get<double>(), 0.0);
+  EXPECT_EQ(summary[1]["sleeping"]["max"].get<double>(), 2.0);
+  const ProgramRun bad = odemag("solve " + shell_quote(scene("bad", R"(, "sleep": {"time": -1})").string()));
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("simulation.sleep.time"), std::string::npos) << bad.err;
+}
+
 // A B-H curve material: `solve` runs it on the CPU backend with "auto" (the
 // default) and refuses "cuda" with exit 2 naming the material's key; the
 // ball's moment is along the field and below the saturated moment.
