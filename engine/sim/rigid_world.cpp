@@ -164,7 +164,6 @@ void RigidWorld::set_enabled(int i, bool enabled) {
     if (bodies_[k].sleeping) wake(k);
   Body& b = bodies_[i];
   b.enabled = enabled;
-  b.sleeping = false;
   b.idle = 0.0;
   if (enabled) {
     dBodyEnable(b.body);

@@ -57,8 +57,8 @@ class RigidWorld {
 
   // Whether the body sleeps (docs/simulation.md "Sleeping bodies"): taken
   // out of ODE's step, at rest, until its applied force or torque moves by
-  // SleepSettings::wake_force of its weight, a moving body touches it, or
-  // the time line moves it.
+  // SleepSettings::wake_force of its weight, a faster or kinematic body
+  // touches it, it touches nothing, or the time line acts.
   bool sleeping(int i) const { return bodies_[i].sleeping; }
   int sleeping_count() const;
 
@@ -112,8 +112,8 @@ class RigidWorld {
   void wake(int i);
   // Before the step: wakes sleeping bodies whose applied force or torque moved.
   void wake_on_force_change();
-  // After the step: notes bodies ODE's islands woke, and puts to sleep the
-  // contact groups whose every body has been slow for SleepSettings::time.
+  // After the step: wakes sleeping bodies with a faster partner, and puts to
+  // sleep each body slow for SleepSettings::time among slow partners.
   void update_sleep(double h);
   double skin_of(dGeomID geom) const;
 
