@@ -52,12 +52,12 @@ inline bool open_reports(const std::string& out_dir, const std::string& csv_path
   return true;
 }
 
-// "a,b,c" -> {"a", "b", "c"}.
-inline std::vector<std::string> split(const std::string& s) {
+// "a,b,c" -> {"a", "b", "c"} (or at another separator).
+inline std::vector<std::string> split(const std::string& s, char separator = ',') {
   std::vector<std::string> out;
   std::stringstream in(s);
   std::string item;
-  while (std::getline(in, item, ',')) out.push_back(item);
+  while (std::getline(in, item, separator)) out.push_back(item);
   return out;
 }
 

@@ -116,7 +116,7 @@ Vec3 bh_flux_cell_law(const BhCurve& curve, double w, const Vec3& b, Vec3& H, do
   return m * u;
 }
 
-BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, const std::vector<double>& fill,
+BhSolveReport solve_bh_lattice(const DemagOperator& demag, const BhCurve& curve, const std::vector<double>& fill,
                                const std::vector<Vec3>& H_source, std::vector<Vec3>& M,
                                const BhSolveOptions& options) {
   const int N = demag.cells();
@@ -187,7 +187,8 @@ BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, 
   double eta = options.forcing;
   while (g > options.tolerance && report.newton_iterations < options.max_newton) {
     for (int i = 0; i < N; ++i) {  // the cell's own block: N(0) of its lattice, less I for (5)
-      const auto& n0 = demag.self_tensor(demag.lattice_of(i));
+      double n0[6];
+      demag.self_block(i, n0);
       Eigen::Matrix3d Ni;
       Ni << n0[0], n0[1], n0[2], n0[1], n0[3], n0[4], n0[2], n0[4], n0[5];
       Eigen::Matrix3d Ji;

@@ -36,7 +36,7 @@
 #include <vector>
 
 #include "magnetics/bh_curve.h"
-#include "magnetics/lattice_fft.h"
+#include "magnetics/demag_operator.h"
 #include "magnetics/vec3.h"
 
 namespace odemag {
@@ -67,7 +67,7 @@ struct BhSolveReport {
 
 // Solves (3) from the initial M (size demag.cells(); a previous solution, or
 // zeros). fill and H_source per cell.
-BhSolveReport solve_bh_lattice(const LatticeDemag& demag, const BhCurve& curve, const std::vector<double>& fill,
+BhSolveReport solve_bh_lattice(const DemagOperator& demag, const BhCurve& curve, const std::vector<double>& fill,
                                const std::vector<Vec3>& H_source, std::vector<Vec3>& M,
                                const BhSolveOptions& options = {});
 

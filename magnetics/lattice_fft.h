@@ -39,6 +39,7 @@
 #include <complex>
 #include <vector>
 
+#include "magnetics/demag_operator.h"
 #include "magnetics/vec3.h"
 
 namespace odemag {
@@ -52,7 +53,7 @@ struct LatticeGrid {
   Vec3 extent{0.0, 0.0, 0.0};
 };
 
-class LatticeDemag {
+class LatticeDemag : public DemagOperator {
  public:
   // cell: the spacing (hx, hy, hz) of every lattice, m, and the edges of
   // its cells unless LatticeGrid::extent says otherwise. force_pairs: the
@@ -61,7 +62,7 @@ class LatticeDemag {
                const std::vector<std::array<int, 2>>& force_pairs = {});
 
   // Active cells, all lattices in order, each in its mask's order (x fastest).
-  int cells() const { return static_cast<int>(cell_index_.size()); }
+  int cells() const override { return static_cast<int>(cell_index_.size()); }
   int cells_of(int lattice) const { return first_[lattice + 1] - first_[lattice]; }
   int first_cell(int lattice) const { return first_[lattice]; }
   Vec3 centre(int cell) const;
@@ -73,13 +74,16 @@ class LatticeDemag {
   int lattice_count() const { return static_cast<int>(lattices_.size()); }
 
   // (1): H (size cells()) from M (size cells()), A/m.
-  void field(const std::vector<Vec3>& M, std::vector<Vec3>& H) const;
+  void field(const std::vector<Vec3>& M, std::vector<Vec3>& H) const override;
   // (2): force (N) on lattice `target` from lattice `source` (a force pair).
   Vec3 force(int target, int source, const std::vector<Vec3>& M) const;
   // The self tensor N(0) of a cell (six components xx, xy, xz, yy, yz, zz).
   const std::array<double, 6>& self_tensor() const { return self_; }
   // The self tensor of a lattice's cells (its extent's).
   const std::array<double, 6>& self_tensor(int lattice) const { return self_of_[lattice]; }
+  void self_block(int cell, double n[6]) const override {
+    for (int c = 0; c < 6; ++c) n[c] = self_of_[lattice_of(cell)][c];
+  }
 
   // The same sums pair by pair (O(N^2)), the reference the FFT is checked against.
   void dense_field(const std::vector<Vec3>& M, std::vector<Vec3>& H) const;

@@ -40,6 +40,7 @@
 #include "magnetics/bh_lattice_solve.h"
 #include "magnetics/cell_field.h"
 #include "magnetics/coil.h"
+#include "magnetics/cuboid_demag.h"
 #include "magnetics/constants.h"
 #include "magnetics/lattice_fft.h"
 
@@ -94,6 +95,27 @@ inline RoundedRectangleCoil coil(double ampere_turns) {
 }
 
 inline const Vec3 kP1{0.0, 0.0, 25.75 * kMm}, kP2{12.5 * kMm, 5 * kMm, 25.75 * kMm};
+
+// The coil's field at 1 A-turn at the cells' centres, and at the first
+// `pole` of them its gradient (row a: d/dx_a) by central differences of step
+// d (the coil field is smooth there: the pole is 7 mm from the copper).
+inline void unit_coil_fields(const std::vector<Vec3>& centres, int pole, double d, std::vector<Vec3>& H,
+                             std::vector<std::array<Vec3, 3>>& gradient) {
+  const RoundedRectangleCoil unit = coil(1.0);
+  const int N = static_cast<int>(centres.size());
+  H.resize(N);
+  gradient.resize(pole);
+#pragma omp parallel for schedule(dynamic, 8)
+  for (int i = 0; i < N; ++i) {
+    H[i] = coil_field_H(unit, centres[i]);
+    if (i < pole)
+      for (int a = 0; a < 3; ++a) {
+        Vec3 e{};
+        e[a] = d;
+        gradient[i][a] = (coil_field_H(unit, centres[i] + e) - coil_field_H(unit, centres[i] - e)) / (2.0 * d);
+      }
+  }
+}
 
 // Lattice of cells of edges e (spacing h per axis) with cell (0, 0, 0)
 // spanning [corner, corner + e] and n cells per axis; a cell where it lies
@@ -167,22 +189,9 @@ struct Problem {
   // balance: also the forces on the yoke from the pole (the momentum check).
   explicit Problem(const Vec3& h_mm, bool with_balance = false)
       : h(kMm * h_mm), balance(with_balance), demag(make(h, with_balance, pole_lattices)) {
-    const RoundedRectangleCoil unit = coil(1.0);
-    const int N = demag.cells(), pole = pole_cells();
-    coil_H.resize(N);
-    coil_gradient.resize(pole);
-    const double d = 1e-2 * std::min({h.x, h.y, h.z});  // central differences of the smooth coil field (the pole is 7 mm from the copper)
-#pragma omp parallel for schedule(dynamic, 8)
-    for (int i = 0; i < N; ++i) {
-      const Vec3 c = demag.centre(i);
-      coil_H[i] = coil_field_H(unit, c);
-      if (i < pole)
-        for (int a = 0; a < 3; ++a) {
-          Vec3 e{};
-          e[a] = d;
-          coil_gradient[i][a] = (coil_field_H(unit, c + e) - coil_field_H(unit, c - e)) / (2.0 * d);
-        }
-    }
+    std::vector<Vec3> centres(demag.cells());
+    for (int i = 0; i < demag.cells(); ++i) centres[i] = demag.centre(i);
+    unit_coil_fields(centres, pole_cells(), 1e-2 * std::min({h.x, h.y, h.z}), coil_H, coil_gradient);
   }
   explicit Problem(double h_mm, bool with_balance = false) : Problem(Vec3{h_mm, h_mm, h_mm}, with_balance) {}
 };
@@ -223,6 +232,121 @@ inline Result solve(const Problem& p, double ampere_turns, std::vector<Vec3>& M,
   r.force_pole = r.force_from_yoke + coil_force;
   r.Bz_P1 = flux_density(p, M, ampere_turns, kP1).z;
   r.Bz_P2 = flux_density(p, M, ampere_turns, kP2).z;
+  return r;
+}
+
+// Graded cells with the mirror planes x = 0 and y = 0 (docs/validation.md
+// "TEAM 20", docs/model.md "Graded cells with mirror planes"): the quarter
+// x, y >= 0 of every box cut into a tensor-product grid whose cells are
+// h_min at the refined faces (every face in the air, the faces where bars
+// meet, and the lines where a facing body's edge lies: the pole's x = 12.5
+// and y = 5 on the bar and the top bars, the columns' x = 38.5 on the bars)
+// and grow by `growth` per cell away from them up to h_max; the symmetry
+// planes are not refined. The dense sum of magnetics/cuboid_demag.h, with
+// the images in both planes.
+struct Grading {
+  double h_min, growth, h_max;  // mm
+};
+
+// Faces of [lo, hi] (mm) graded toward the refine points (those within [lo,
+// hi] are faces): the target edge s(x) = min(h_max, h_min + (growth - 1)
+// dist(x, refine)) grows geometrically along a march; each stretch between
+// faces is cut into ceil(integral dx / s) cells of equal share of that
+// integral.
+inline std::vector<double> graded_faces(double lo, double hi, const std::vector<double>& refine, const Grading& g) {
+  std::vector<double> breaks = {lo, hi};
+  for (double r : refine)
+    if (r > lo && r < hi) breaks.push_back(r);
+  std::sort(breaks.begin(), breaks.end());
+  auto edge = [&](double x) {
+    double d = 1e300;
+    for (double r : refine) d = std::min(d, std::fabs(x - r));
+    return std::min(g.h_max, g.h_min + (g.growth - 1.0) * d);
+  };
+  std::vector<double> faces = {lo};
+  constexpr int kSamples = 4000;
+  for (size_t b = 0; b + 1 < breaks.size(); ++b) {
+    const double a = breaks[b], c = breaks[b + 1], dx = (c - a) / kSamples;
+    std::vector<double> phi(kSamples + 1, 0.0);  // integral of dx / s from a
+    for (int k = 0; k < kSamples; ++k) phi[k + 1] = phi[k] + dx / edge(a + (k + 0.5) * dx);
+    const int n = std::max(1, static_cast<int>(std::ceil(phi[kSamples] - 1e-6)));
+    int k = 0;
+    for (int f = 1; f < n; ++f) {
+      const double target = phi[kSamples] * f / n;
+      while (phi[k + 1] < target) ++k;
+      faces.push_back(a + dx * (k + (target - phi[k]) / (phi[k + 1] - phi[k])));
+    }
+    faces.push_back(c);
+  }
+  return faces;
+}
+
+struct GradedProblem {
+  Grading grading;
+  bool balance = false;
+  int pole_cells = 0;  // the pole's cells come first
+  CuboidDemag demag;
+  std::vector<Vec3> coil_H;                        // at 1 A-turn, at the cell centres
+  std::vector<std::array<Vec3, 3>> coil_gradient;  // pole cells: d(coil_H)/dx_a, 1 A-turn
+  BhCurve curve{bh_table()};
+
+  // The quarter boxes (mm) with their refine points per axis.
+  struct QuarterBox {
+    std::array<double, 2> x, y, z;
+    std::vector<double> refine_x, refine_y, refine_z;
+  };
+  static std::vector<QuarterBox> boxes() {
+    return {{{0, 12.5}, {0, 5}, {26.5, 125}, {12.5}, {5}, {26.5, 125}},                  // pole
+            {{0, 63.5}, {0, 12.5}, {0, 25}, {12.5, 38.5, 63.5}, {5, 12.5}, {0, 25}},    // bottom bar
+            {{38.5, 63.5}, {0, 12.5}, {25, 125}, {38.5, 63.5}, {5, 12.5}, {25, 125}},   // column
+            {{13.5, 63.5}, {0, 12.5}, {125, 150}, {13.5, 38.5, 63.5}, {5, 12.5}, {125, 150}}};  // top bar
+  }
+  static std::vector<CuboidCell> make(const Grading& g, int& pole_cells) {
+    std::vector<CuboidCell> cells;
+    bool first = true;
+    for (const QuarterBox& b : boxes()) {
+      auto faces = [&](const std::array<double, 2>& range, const std::vector<double>& refine) {
+        std::vector<double> f = graded_faces(range[0], range[1], refine, g);
+        for (double& x : f) x *= kMm;
+        return f;
+      };
+      const auto box = grid_cells(faces(b.x, b.refine_x), faces(b.y, b.refine_y), faces(b.z, b.refine_z));
+      cells.insert(cells.end(), box.begin(), box.end());
+      if (first) pole_cells = static_cast<int>(cells.size());
+      first = false;
+    }
+    return cells;
+  }
+
+  // balance: also the forces on the yoke from the pole (the momentum check).
+  explicit GradedProblem(const Grading& g, bool with_balance = false)
+      : grading(g), balance(with_balance), demag(make(g, pole_cells), true, true) {
+    std::vector<Vec3> centres(demag.cells());
+    for (int i = 0; i < demag.cells(); ++i) centres[i] = demag.cell(i).centre;
+    unit_coil_fields(centres, pole_cells, 1e-2 * kMm * g.h_min, coil_H, coil_gradient);
+  }
+  // All cells of the whole problem (the quarter's times four).
+  int full_cells() const { return 4 * demag.cells(); }
+};
+
+inline Result solve(const GradedProblem& p, double ampere_turns, std::vector<Vec3>& M, const BhSolveOptions& options = {}) {
+  const int N = p.demag.cells();
+  std::vector<Vec3> source(N);
+  for (int i = 0; i < N; ++i) source[i] = ampere_turns * p.coil_H[i];
+  Result r;
+  const std::vector<double> fill(N, 1.0);
+  r.report = solve_bh_lattice(p.demag, p.curve, fill, source, M, options);
+  r.force_from_yoke = p.demag.force(0, p.pole_cells, p.pole_cells, N, M);
+  if (p.balance) r.force_on_yoke = p.demag.force(p.pole_cells, N, 0, p.pole_cells, M);
+  // The coil's part on the quarter's pole cells, then on all four images.
+  Vec3 quarter{};
+  for (int i = 0; i < p.pole_cells; ++i)
+    for (int a = 0; a < 3; ++a) quarter += (kMu0 * p.demag.volume(i) * ampere_turns * M[i][a]) * p.coil_gradient[i][a];
+  Vec3 coil_force{};
+  for (const Vec3& s : p.demag.images()) coil_force += Vec3{s.x * quarter.x, s.y * quarter.y, s.z * quarter.z};
+  r.force_pole = r.force_from_yoke + coil_force;
+  r.Bz_P1 = kMu0 * (coil_field_H(coil(ampere_turns), kP1) + p.demag.field_at(kP1, M)).z;
+  r.Bz_P2 = kMu0 * (coil_field_H(coil(ampere_turns), kP2) + p.demag.field_at(kP2, M)).z;
   return r;
 }
 
