@@ -240,7 +240,8 @@ inline Result solve(const Problem& p, double ampere_turns, std::vector<Vec3>& M,
 // x, y >= 0 of every box cut into a tensor-product grid whose cells are
 // h_min at the refined faces (every face in the air, the faces where bars
 // meet, and the lines where a facing body's edge lies: the pole's x = 12.5
-// and y = 5 on the bar and the top bars, the columns' x = 38.5 on the bars)
+// on the bar, its y = 5 on the bar, the columns and the top bars, the
+// columns' x = 38.5 on the bar and the top bars)
 // and grow by `growth` per cell away from them up to h_max; the symmetry
 // planes are not refined. The dense sum of magnetics/cuboid_demag.h, with
 // the images in both planes.
