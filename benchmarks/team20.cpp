@@ -21,7 +21,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -55,11 +54,10 @@ struct Row {
   double setup, solve;
 };
 
-void write_row(FILE* csv, FILE* md, const Row& w, const team20::Measured& m, const team20::Result& r,
-               const Vec3& force_on_yoke) {
+void write_row(FILE* csv, FILE* md, const Row& w, const team20::Measured& m, const team20::Result& r) {
   const double F = -r.force_pole.z;  // toward the bar
   const double eF = F / m.force - 1.0, e1 = r.Bz_P1 / m.Bz_P1 - 1.0, e2 = r.Bz_P2 / m.Bz_P2 - 1.0;
-  const double balance = norm(r.force_from_yoke + force_on_yoke) / norm(r.force_from_yoke);
+  const double balance = norm(r.force_from_yoke + r.force_on_yoke) / norm(r.force_from_yoke);
   const bool graded = w.unknown_cells != w.cells;
   std::fprintf(csv, "%.4f,%.4f,%.4f,%d,%d,", w.a, w.b, w.c, w.cells, w.pole_cells);
   if (graded) std::fprintf(csv, "%d,", w.unknown_cells);
@@ -155,52 +153,62 @@ int main(int argc, char** argv) {
       const auto t1 = std::chrono::steady_clock::now();
       const team20::Result r = team20::solve(p, m.ampere_turns, M, options);
       w.solve = seconds_since(t1);
-      write_row(csv, md, w, m, r, r.force_on_yoke);
+      write_row(csv, md, w, m, r);
     }
   };
   const char* newton = variable == BhNewtonVariable::flux_density ? "b = H + M" : "H";
-  if (!hs.empty()) {
+  // DIR/<stem>.csv and .md with their headers, the rows of body(csv, md).
+  auto reports = [&](const std::string& stem, const std::string& csv_head, const std::string& md_head, const auto& body) {
     FILE *csv = nullptr, *md = nullptr;
-    if (!bench::open_reports(out, out + "/team20.csv", out + "/team20.md", csv, md)) return 1;
-    std::fprintf(csv, "hx_mm,hy_mm,hz_mm,cells,pole_cells,%s", kColumns);
-    std::fprintf(md,
-                 "# TEAM 20: force on the pole and gap flux density against the measured values\n\n"
-                 "benchmarks/team20 (docs/validation.md \"TEAM 20\"), %d thread(s). Solve: Newton-GMRES in %s from M = 0, "
-                 "tolerance 1e-4. Errors relative to the measured values (COMPEL 14(2/3), 1995).\n\n"
-                 "| h (mm) | cells |%s|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-                 threads, newton, kTableHead);
-    for (const std::string& hstr : hs) {
-      const Vec3 h = edges(hstr);
-      const auto t0 = std::chrono::steady_clock::now();
-      const team20::Problem p(h, true);
-      const double setup = seconds_since(t0);
-      solve_excitations(p, {hstr, h.x, h.y, h.z, p.demag.cells(), p.pole_cells(), p.demag.cells(), threads, setup, 0.0}, csv, md);
-    }
+    if (!bench::open_reports(out, out + "/" + stem + ".csv", out + "/" + stem + ".md", csv, md)) return false;
+    std::fprintf(csv, "%s%s", csv_head.c_str(), kColumns);
+    const std::string table = md_head + kTableHead;
+    std::fprintf(md, "%s|", table.c_str());
+    const long columns = std::count(table.begin() + static_cast<long>(table.rfind("\n\n")), table.end(), '|') - 1;
+    for (long c = 0; c < columns; ++c) std::fprintf(md, "---|");
+    std::fprintf(md, "\n");
+    body(csv, md);
     std::fclose(csv);
     std::fclose(md);
-  }
-  if (!gradings.empty()) {
-    FILE *csv = nullptr, *md = nullptr;
-    if (!bench::open_reports(out, out + "/team20_graded.csv", out + "/team20_graded.md", csv, md)) return 1;
-    std::fprintf(csv, "h_min_mm,growth,h_max_mm,cells,pole_cells,unknown_cells,%s", kColumns);
-    std::fprintf(md,
-                 "# TEAM 20 on graded cells with mirror planes\n\n"
-                 "benchmarks/team20 --graded (docs/validation.md \"TEAM 20\"), %d thread(s): the quarter x, y >= 0 with "
-                 "its images in x = 0 and y = 0, cells h_min at the refined faces growing by `growth` per cell up to h_max "
-                 "(team20::GradedProblem), the dense sum of magnetics/cuboid_demag.h. Solve: Newton-GMRES in %s from M = 0, "
-                 "tolerance 1e-4. Cells: the whole problem's (four times the unknown cells).\n\n"
-                 "| h_min / growth / h_max (mm) | cells | unknown cells |%s|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-                 threads, newton, kTableHead);
-    for (const std::string& spec : gradings) {
-      const team20::Grading g = grading(spec);
-      const auto t0 = std::chrono::steady_clock::now();
-      const team20::GradedProblem p(g, true);
-      const double setup = seconds_since(t0);
-      solve_excitations(p, {spec, g.h_min, g.growth, g.h_max, p.full_cells(), 4 * p.pole_cells, p.demag.cells(), threads, setup, 0.0},
-                        csv, md);
-    }
-    std::fclose(csv);
-    std::fclose(md);
-  }
+    return true;
+  };
+  const std::string solve_line = std::string(" Solve: Newton-GMRES in ") + newton + " from M = 0, tolerance 1e-4.";
+  const std::string thread_count = std::to_string(threads) + " thread(s).";
+  if (!hs.empty() &&
+      !reports("team20", "hx_mm,hy_mm,hz_mm,cells,pole_cells,",
+               "# TEAM 20: force on the pole and gap flux density against the measured values\n\n"
+               "benchmarks/team20 (docs/validation.md \"TEAM 20\"), " + thread_count + solve_line +
+                   " Errors relative to the measured values (COMPEL 14(2/3), 1995).\n\n| h (mm) | cells |",
+               [&](FILE* csv, FILE* md) {
+                 for (const std::string& hstr : hs) {
+                   const Vec3 h = edges(hstr);
+                   const auto t0 = std::chrono::steady_clock::now();
+                   const team20::Problem p(h, true);
+                   const double setup = seconds_since(t0);
+                   solve_excitations(p, {hstr, h.x, h.y, h.z, p.demag.cells(), p.pole_cells(), p.demag.cells(), threads, setup, 0.0},
+                                     csv, md);
+                 }
+               }))
+    return 1;
+  if (!gradings.empty() &&
+      !reports("team20_graded", "h_min_mm,growth,h_max_mm,cells,pole_cells,unknown_cells,",
+               "# TEAM 20 on graded cells with mirror planes\n\n"
+               "benchmarks/team20 --graded (docs/validation.md \"TEAM 20\"), " + thread_count +
+                   " The quarter x, y >= 0 with its images in x = 0 and y = 0, cells h_min at the refined faces growing by "
+                   "`growth` per cell up to h_max (team20::GradedProblem), the dense sum of magnetics/cuboid_demag.h." +
+                   solve_line + " Cells: the whole problem's (four times the unknown cells).\n\n"
+                   "| h_min / growth / h_max (mm) | cells | unknown cells |",
+               [&](FILE* csv, FILE* md) {
+                 for (const std::string& spec : gradings) {
+                   const team20::Grading g = grading(spec);
+                   const auto t0 = std::chrono::steady_clock::now();
+                   const team20::GradedProblem p(g, true);
+                   const double setup = seconds_since(t0);
+                   solve_excitations(p, {spec, g.h_min, g.growth, g.h_max, p.full_cells(), 4 * p.pole_cells, p.demag.cells(),
+                                         threads, setup, 0.0},
+                                     csv, md);
+                 }
+               }))
+    return 1;
   return 0;
 }

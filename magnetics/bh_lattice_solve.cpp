@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 
+#include "magnetics/eigen_tensors.h"
 #include "magnetics/kernels.h"
 
 namespace odemag {
@@ -189,11 +190,8 @@ BhSolveReport solve_bh_lattice(const DemagOperator& demag, const BhCurve& curve,
     for (int i = 0; i < N; ++i) {  // the cell's own block: N(0) of its lattice, less I for (5)
       double n0[6];
       demag.self_block(i, n0);
-      Eigen::Matrix3d Ni;
-      Ni << n0[0], n0[1], n0[2], n0[1], n0[3], n0[4], n0[2], n0[4], n0[5];
-      Eigen::Matrix3d Ji;
-      const auto& j = J[i];
-      Ji << j[0], j[1], j[2], j[1], j[3], j[4], j[2], j[4], j[5];
+      Eigen::Matrix3d Ni = symmetric_matrix(n0);
+      const Eigen::Matrix3d Ji = symmetric_matrix(J[i].data());
       if (flux) Ni -= Eigen::Matrix3d::Identity();
       block[i] = (Eigen::Matrix3d::Identity() + Ni * Ji).inverse();
     }

@@ -6,6 +6,7 @@
 #include "magnetics/cell_field.h"
 #include "magnetics/constants.h"
 #include "magnetics/demag_tensor.h"
+#include "magnetics/eigen_tensors.h"
 
 namespace odemag {
 
@@ -52,9 +53,7 @@ CuboidDemag::CuboidDemag(std::vector<CuboidCell> cell_list, bool mirror_x, bool 
         const double dd[3] = {d.x, d.y, d.z};
         double n[6];
         cuboid_demag_tensor(ha, hb, dd, n);
-        Eigen::Matrix3d Nm;
-        Nm << n[0], n[1], n[2], n[1], n[3], n[4], n[2], n[4], n[5];
-        k += Nm * Eigen::Vector3d(s.x, s.y, s.z).asDiagonal();
+        k += symmetric_matrix(n) * Eigen::Vector3d(s.x, s.y, s.z).asDiagonal();
       }
       K_.block<3, 3>(3 * i, 3 * j) = k;
       if (j != i) K_.block<3, 3>(3 * j, 3 * i) = (volume(i) / volume(j)) * k.transpose();
