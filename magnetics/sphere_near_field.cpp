@@ -362,14 +362,20 @@ struct SphereCell {
   bool multipoles() const { return !rigid(chi); }
 };
 
+// A pair's data in two parts, side by side in two arrays: what every field
+// sum reads (add_field runs at every outer iteration over tens of thousands
+// of pairs, and reading only this part halves the bytes it streams), and what
+// the forces and the carry-over read besides.
 struct SpherePair {
-  int a = -1, b = -1;                // cells
-  int sa = -1, sb = -1;              // their SphereCells
+  int sa = -1, sb = -1;              // the SphereCells
   Vec3 u;                            // (x_b - x_a) / d
-  double d = 0.0;
   double k[6] = {};                  // K entries, 1/m^3: [par aa, ab, bb, perp aa, ab, bb]
-  double dk[6] = {};                 // dK/dd, 1/m^4
   double contact[4] = {};            // PairTable::contact
+};
+struct SpherePairSlope {
+  int a = -1, b = -1;                // cells (the carry-over's key: stable from build to build)
+  double d = 0.0;
+  double dk[6] = {};                 // dK/dd, 1/m^4
   double d0 = 0.0;                   // where k0, dk and contact were evaluated
   double k0[6] = {};                 // K at d0 (a carried pair's K is k0 + dk (d - d0))
 };
@@ -410,8 +416,13 @@ class SphereNearField final : public NearFieldTerm {
     // The last build's pairs, in the same (a, b) order, for the carry-over
     // (the two buffers swap: no allocation in the steady state).
     previous_.swap(pairs_);
-    if (model.generation() != generation_) previous_.clear();
+    previous_slopes_.swap(slopes_);
+    if (model.generation() != generation_) {
+      previous_.clear();
+      previous_slopes_.clear();
+    }
     pairs_.clear();
+    slopes_.clear();
     generation_ = model.generation();
     size_t next_previous = 0;
     std::map<std::pair<int, int>, std::shared_ptr<const PairTable>> tables;  // by (type a, type b)
@@ -440,19 +451,20 @@ class SphereNearField final : public NearFieldTerm {
         const Vec3 u = d > 0.0 ? r / d : Vec3{0.0, 0.0, 1.0};
         // Carried over: the pair's last evaluation, if close enough (header comment).
         const std::pair<int, int> key{ca.cell, cb.cell};
-        while (next_previous < previous_.size() &&
-               std::make_pair(previous_[next_previous].a, previous_[next_previous].b) < key)
+        while (next_previous < previous_slopes_.size() &&
+               std::make_pair(previous_slopes_[next_previous].a, previous_slopes_[next_previous].b) < key)
           ++next_previous;
-        if (next_previous < previous_.size() &&
-            std::make_pair(previous_[next_previous].a, previous_[next_previous].b) == key) {
-          const SpherePair& q = previous_[next_previous];
+        if (next_previous < previous_slopes_.size() &&
+            std::make_pair(previous_slopes_[next_previous].a, previous_slopes_[next_previous].b) == key) {
+          const SpherePairSlope& q = previous_slopes_[next_previous];
           const double delta = d - q.d0;
           if (q.d0 > reach && std::fabs(delta) <= kReuseTolerance * std::min(q.d0 - reach, reach)) {
-            SpherePair& p = pairs_.emplace_back(q);
+            SpherePair& p = pairs_.emplace_back(previous_[next_previous]);
+            SpherePairSlope& ps = slopes_.emplace_back(q);
             p.sa = i, p.sb = j;
-            p.d = d;
+            ps.d = d;
             p.u = u;
-            for (int s = 0; s < 6; ++s) p.k[s] = p.k0[s] + p.dk[s] * delta;
+            for (int s = 0; s < 6; ++s) p.k[s] = ps.k0[s] + ps.dk[s] * delta;
             continue;
           }
         }
@@ -463,13 +475,14 @@ class SphereNearField final : public NearFieldTerm {
           table = t.get();
         }
         SpherePair& p = pairs_.emplace_back();
-        p.a = ca.cell, p.b = cb.cell;
+        SpherePairSlope& ps = slopes_.emplace_back();
+        ps.a = ca.cell, ps.b = cb.cell;
         p.sa = i, p.sb = j;
-        p.d = p.d0 = d;
+        ps.d = ps.d0 = d;
         p.u = u;
-        table->eval(d, reach, p.k, p.dk);
+        table->eval(d, reach, p.k, ps.dk);
         table->contact(d, reach, p.contact);
-        std::copy(p.k, p.k + 6, p.k0);
+        std::copy(p.k, p.k + 6, ps.k0);
       }
     }
   }
@@ -486,8 +499,8 @@ class SphereNearField final : public NearFieldTerm {
       const Vec3 zb = cb.responsive == responsive_sources ? m.dipole[p.sb] : Vec3{};
       Vec3 Ha, Hb;
       apply(p, za, zb, Ha, Hb);
-      if (ca.responsive) H[p.a] += sigma * Ha;
-      if (cb.responsive) H[p.b] += sigma * Hb;
+      if (ca.responsive) H[ca.cell] += sigma * Ha;
+      if (cb.responsive) H[cb.cell] += sigma * Hb;
     }
   }
 
@@ -495,18 +508,20 @@ class SphereNearField final : public NearFieldTerm {
                   std::vector<Vec3>& field) const override {
     (void)model;
     const SphereMoments& m = moments(state);
-    for (const SpherePair& p : pairs_) {
+    for (size_t q = 0; q < pairs_.size(); ++q) {
+      const SpherePair& p = pairs_[q];
+      const SpherePairSlope& ps = slopes_[q];
       const double sigma = saturation_factor(m, p);
       const Vec3 &pa = m.dipole[p.sa], &pb = m.dipole[p.sb];
       // F_b = +mu0/2 sigma grad_r (sum_xy p_x . K_xy p_y), F_a = -F_b.
-      const Vec3 g = gradient(p, 0, pa, pa) + 2.0 * gradient(p, 1, pa, pb) + gradient(p, 2, pb, pb);
+      const Vec3 g = gradient(p, ps, 0, pa, pa) + 2.0 * gradient(p, ps, 1, pa, pb) + gradient(p, ps, 2, pb, pb);
       const Vec3 Fb = 0.5 * kMu0 * sigma * g;
-      force[p.b] += Fb;
-      force[p.a] -= Fb;
+      force[ps.b] += Fb;
+      force[ps.a] -= Fb;
       Vec3 Ha, Hb;
       apply(p, pa, pb, Ha, Hb);
-      field[p.a] += sigma * Ha;
-      field[p.b] += sigma * Hb;
+      field[ps.a] += sigma * Ha;
+      field[ps.b] += sigma * Hb;
     }
   }
 
@@ -548,11 +563,11 @@ class SphereNearField final : public NearFieldTerm {
     Hb = p.k[4] * pa + p.k[5] * pb + (d_ab * ua + d_bb * ub) * p.u;
   }
   // grad_r of s . K_xy(r) t, r = x_b - x_a.
-  static Vec3 gradient(const SpherePair& p, int xy, const Vec3& s, const Vec3& t) {
-    const double dpar = p.dk[xy], dperp = p.dk[3 + xy], delta = p.k[xy] - p.k[3 + xy];
+  static Vec3 gradient(const SpherePair& p, const SpherePairSlope& ps, int xy, const Vec3& s, const Vec3& t) {
+    const double dpar = ps.dk[xy], dperp = ps.dk[3 + xy], delta = p.k[xy] - p.k[3 + xy];
     const double us = dot(p.u, s), ut = dot(p.u, t);
     Vec3 g = (dperp * dot(s, t) + (dpar - dperp) * us * ut) * p.u;
-    if (p.d > 0.0) g += (delta / p.d) * ((s - us * p.u) * ut + us * (t - ut * p.u));
+    if (ps.d > 0.0) g += (delta / ps.d) * ((s - us * p.u) * ut + us * (t - ut * p.u));
     return g;
   }
   // Local saturation at the contact points: the linear higher orders would
@@ -574,7 +589,9 @@ class SphereNearField final : public NearFieldTerm {
 
   std::vector<SphereCell> cells_;
   std::vector<SpherePair> pairs_;
-  std::vector<SpherePair> previous_;  // the build before, for the carry-over
+  std::vector<SpherePairSlope> slopes_;  // beside pairs_, index for index
+  std::vector<SpherePair> previous_;     // the build before, for the carry-over
+  std::vector<SpherePairSlope> previous_slopes_;
   std::vector<Vec3> centre_;           // scratch of build: the spheres' centres
   std::vector<double> radius_;         // and radii
   uint64_t generation_ = 0;           // the model whose pairs pairs_ holds
