@@ -6,13 +6,15 @@
 // field evaluations (matvecs: GMRES iterations, restarts and residuals).
 //
 // Usage: team20 [--out DIR] [--h 5,2.5x2.5x5,2.5] [--graded 2.5/1.5/10,...]
-//               [--ampere-turns 1000,...] [--threads T] [--newton-variable flux|field]
+//               [--graded-name STEM] [--ampere-turns 1000,...] [--threads T]
+//               [--newton-variable flux|field]
 // (--h: FFT lattices of edge h, or edges hx x hy x hz, in mm, written to
 // DIR/team20.csv and .md; --graded: the quarter model with mirror planes and
 // graded cells h_min/growth/h_max (mm; growth 1: uniform),
-// team20::GradedProblem, written to DIR/team20_graded.csv and .md, only
-// when given; --ampere-turns: a subset of the four excitations; the Newton
-// variable b = H + M, the default, or H: magnetics/bh_lattice_solve.h).
+// team20::GradedProblem, written to DIR/STEM.csv and .md, only when given,
+// STEM team20_graded unless --graded-name says otherwise; --ampere-turns: a
+// subset of the four excitations; the Newton variable b = H + M, the
+// default, or H: magnetics/bh_lattice_solve.h).
 // DIR: benchmarks/results. Runs itself again with OMP_WAIT_POLICY=passive
 // when that is unset.
 #include <omp.h>
@@ -106,6 +108,7 @@ int main(int argc, char** argv) {
   bench::restart_with_passive_omp(argv);
   std::string out = "benchmarks/results";
   std::vector<std::string> hs = {"5", "2.5x2.5x5", "2.5"}, gradings;
+  std::string graded_name = "team20_graded";
   int threads = 2;
   std::vector<double> excitations;  // empty: the four measured
   BhNewtonVariable variable = BhNewtonVariable::flux_density;
@@ -117,6 +120,12 @@ int main(int argc, char** argv) {
       hs = bench::split(bench::option_value(argc, argv, i, "team20"));
     } else if (a == "--graded") {
       gradings = bench::split(bench::option_value(argc, argv, i, "team20"));
+    } else if (a == "--graded-name") {
+      graded_name = bench::option_value(argc, argv, i, "team20");
+      if (graded_name.empty() || graded_name.find('/') != std::string::npos) {
+        std::fprintf(stderr, "team20: --graded-name wants a file name stem, not '%s'\n", graded_name.c_str());
+        return 2;
+      }
     } else if (a == "--ampere-turns") {
       for (const std::string& v : bench::split(bench::option_value(argc, argv, i, "team20"))) excitations.push_back(std::stod(v));
     } else if (a == "--threads") {
@@ -126,7 +135,7 @@ int main(int argc, char** argv) {
       variable = std::string(argv[++i]) == "flux" ? BhNewtonVariable::flux_density : BhNewtonVariable::field;
     } else {
       std::fprintf(stderr,
-                   "usage: team20 [--out DIR] [--h 5,2.5x2.5x5,...] [--graded h_min/growth/h_max,...] "
+                   "usage: team20 [--out DIR] [--h 5,2.5x2.5x5,...] [--graded h_min/growth/h_max,...] [--graded-name STEM] "
                    "[--ampere-turns 1000,...] [--threads T] [--newton-variable flux|field]\n");
       return 2;
     }
@@ -191,7 +200,7 @@ int main(int argc, char** argv) {
                }))
     return 1;
   if (!gradings.empty() &&
-      !reports("team20_graded", "h_min_mm,growth,h_max_mm,cells,pole_cells,unknown_cells,",
+      !reports(graded_name, "h_min_mm,growth,h_max_mm,cells,pole_cells,unknown_cells,",
                "# TEAM 20 on graded cells with mirror planes\n\n"
                "benchmarks/team20 --graded (docs/validation.md \"TEAM 20\"), " + thread_count +
                    " The quarter x, y >= 0 with its images in x = 0 and y = 0, cells h_min at the refined faces growing by "
