@@ -135,8 +135,22 @@ struct PairGeometry {
   double dTc[3][6];        // dT_c / dr_k, world, 1/m^4 (only with gradients)
 };
 
-// Rotated symmetric tensor R S R^T (six components xx, xy, xz, yy, yz, zz).
+bool is_identity(const Mat3& R) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (R.m[i][j] != (i == j ? 1.0 : 0.0)) return false;
+  return true;
+}
+
+// Rotated symmetric tensor R S R^T (six components xx, xy, xz, yy, yz, zz);
+// S itself where R is the identity (a lattice body that has not turned, as
+// the fixed magnets of most scenes: four of these per pair are a third of
+// the pairs' arithmetic).
 void rotate_symmetric(const Mat3& R, const double s[6], double out[6]) {
+  if (is_identity(R)) {
+    std::copy(s, s + 6, out);
+    return;
+  }
   constexpr int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
   const double S[3][3] = {{s[0], s[1], s[2]}, {s[1], s[3], s[4]}, {s[2], s[4], s[5]}};
   double RS[3][3];
@@ -377,6 +391,17 @@ struct BallCellPair {
   PairGeometry base;            // evaluated at r0 (PairGroup)
 };
 
+// What the field sums (add_field at every outer iteration, energy) read of a
+// pair, copied from the pairs at the end of every build in for_each_pair's
+// order: 80 bytes a pair streamed instead of a whole BallCellPair (over 600
+// bytes with its two geometries).
+struct PairCoupling {
+  int b = -1, c = -1;
+  bool responsive_b = false, responsive_c = false;
+  double volume_b = 0.0, volume_c = 0.0;
+  double K[6];
+};
+
 // A ball's pairs with one lattice body, kept from build to build: while the
 // ball's centre stays within kReuseTolerance R of q0 in the body's frame and
 // the frame has not turned, the pairs are those evaluated at q0, carried to
@@ -402,6 +427,7 @@ class BallLatticeNearField final : public NearFieldTerm {
     balls_.clear();
     lattices_.clear();
     active_groups_.clear();
+    couplings_.clear();
     if (model.intra_body_tensor() != IntraBodyTensor::cell_average) return;
     if (model.generation() != cached_generation_ || cached_bodies_ != model.body_count()) cache_lattices(model);
     for (int bi = 0; bi < model.body_count(); ++bi) {
@@ -482,17 +508,23 @@ class BallLatticeNearField final : public NearFieldTerm {
         }
       }
     }
+    couplings_.clear();
+    for_each_pair([&](const BallCellPair& p) {
+      PairCoupling k{p.b, p.c, p.responsive_b, p.responsive_c, p.volume_b, p.volume_c, {}};
+      std::copy(p.K, p.K + 6, k.K);
+      couplings_.push_back(k);
+    });
   }
 
   void add_field(const MagneticModel& /*model*/, const MagneticState& state, NearFieldSources sources,
                  std::vector<Vec3>& H) const override {
     const bool responsive_sources = sources == NearFieldSources::responsive;
-    for_each_pair([&](const BallCellPair& p) {
+    for (const PairCoupling& p : couplings_) {
       if (p.responsive_b && p.responsive_c == responsive_sources)
         H[p.b] += symmetric_times(p.K, p.volume_c * state.magnetization[p.c]);
       if (p.responsive_c && p.responsive_b == responsive_sources)
         H[p.c] += symmetric_times(p.K, p.volume_b * state.magnetization[p.b]);
-    });
+    }
   }
 
   void add_forces(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& force,
@@ -542,16 +574,13 @@ class BallLatticeNearField final : public NearFieldTerm {
 
   double energy(const MagneticModel& /*model*/, const MagneticState& state) const override {
     double e = 0.0;
-    for_each_pair([&](const BallCellPair& p) {
+    for (const PairCoupling& p : couplings_)
       e -= kMu0 * dot(p.volume_b * state.magnetization[p.b], symmetric_times(p.K, p.volume_c * state.magnetization[p.c]));
-    });
     return e;
   }
 
   int pair_count() const override {
-    int n = 0;
-    for (std::size_t gi : active_groups_) n += static_cast<int>(groups_[gi].pairs.size());
-    return n;
+    return static_cast<int>(couplings_.size());
   }
 
  private:
@@ -655,6 +684,7 @@ class BallLatticeNearField final : public NearFieldTerm {
   // kept across builds; those of the current build in active_groups_.
   std::vector<PairGroup> groups_;
   std::vector<std::size_t> active_groups_;
+  std::vector<PairCoupling> couplings_;  // every pair of the current build (for_each_pair's order)
 };
 
 }  // namespace

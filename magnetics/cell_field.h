@@ -26,7 +26,7 @@ ODEMAG_HD Vec3 uniform_sphere_field(const Vec3& r, double R, const Vec3& mu) {
 // diverges; rho is floored at eps there, so that on an edge shared by
 // neighbouring cubes of a lattice their equal and opposite terms cancel.
 ODEMAG_HD double log_pair(double X, double Y, double Z1, double Z2, double eps) {
-  const double rho2 = fmax(X * X + Y * Y, eps * eps);
+  const double rho2 = larger(X * X + Y * Y, eps * eps);
   const double R1 = sqrt(rho2 + Z1 * Z1), R2 = sqrt(rho2 + Z2 * Z2);
   if (Z1 >= 0.0 && Z2 >= 0.0) return log((Z2 + R2) / (Z1 + R1));
   if (Z1 < 0.0 && Z2 < 0.0) return log((R1 - Z1) / (R2 - Z2));
@@ -48,7 +48,7 @@ ODEMAG_HD double corner_angle(double X, double Y, double Z) {
 // edge (B < 0 < A) it diverges like 1 / rho^2 on the edge itself (rho floored
 // at eps, as in log_pair).
 ODEMAG_HD double edge_ratio(double X, double Y, double A, double B, double eps) {
-  const double rho2 = fmax(X * X + Y * Y, eps * eps);
+  const double rho2 = larger(X * X + Y * Y, eps * eps);
   const double RA = sqrt(rho2 + A * A), RB = sqrt(rho2 + B * B);
   if (A * B >= 0.0) {
     const double den = A * RB + B * RA;
@@ -87,7 +87,7 @@ ODEMAG_HD void cuboid_corner(double X, double Y, double Z, double eps, bool with
   angle[0] = corner_angle(Xs, Ys, Zs);
   angle[1] = corner_angle(Ys, Xs, Zs);
   angle[2] = corner_angle(Zs, Xs, Ys);
-  if (with_gradient) inverse_distance = 1.0 / sqrt(fmax(X * X + Y * Y + Z * Z, eps * eps));
+  if (with_gradient) inverse_distance = 1.0 / sqrt(larger(X * X + Y * Y + Z * Z, eps * eps));
 }
 
 // log_pair of the edge at offsets (U, W) from its two planes, running from

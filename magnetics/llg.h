@@ -175,7 +175,7 @@ ODEMAG_HD double cell_torque_residual(const SoftCellParams& p, const Vec3& H_A, 
   const Vec3 mean_m = mean_moment(m, p.n);
   double worst = 0.0;
   for (int k = 0; k < p.n; ++k)
-    worst = fmax(worst, norm(cross(m[k], effective_field(p, H_A, mean_m, m[k]))));
+    worst = larger(worst, norm(cross(m[k], effective_field(p, H_A, mean_m, m[k]))));
   return worst / torque_scale(p, H_A, mean_m);
 }
 
@@ -217,7 +217,7 @@ ODEMAG_HD bool structured_newton_step(const SoftCellParams& p, const Vec3* m, co
                  ve = dot(v, p.easy_axis), hk = p.H_K * inv_n;
     const double duu = hk * (1.0 - ue * ue) + q, duv = -hk * ue * ve, dvv = hk * (1.0 - ve * ve) + q;
     const double half_trace = 0.5 * (duu + dvv), det = duu * dvv - duv * duv;
-    const double lowest = half_trace - sqrt(fmax(0.0, half_trace * half_trace - det));
+    const double lowest = half_trace - sqrt(larger(0.0, half_trace * half_trace - det));
     if (!(lowest > floor)) return false;
     dinv[k][0] = dvv / det;
     dinv[k][1] = -duv / det;
@@ -342,13 +342,13 @@ ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, i
           for (int i = 0; i < dim; ++i) {
             double vg = 0.0;
             for (int a = 0; a < dim; ++a) vg += evec[a * dim + i] * grad[a];
-            const double lam = fmax(fabs(eval[i]), 1e-14 * curvature_scale);
+            const double lam = larger(fabs(eval[i]), 1e-14 * curvature_scale);
             for (int a = 0; a < dim; ++a) step[a] -= (vg / lam) * evec[a * dim + i];
           }
         } else {
           if (!factored) {
             double mu = 1e-12 * curvature_scale;
-            for (int k = 0; k < n; ++k) mu = fmax(mu, -inv_n * dot(m[k], heff[k]) + 1e-12 * curvature_scale);
+            for (int k = 0; k < n; ++k) mu = larger(mu, -inv_n * dot(m[k], heff[k]) + 1e-12 * curvature_scale);
             for (int i = 0; i < dim * dim; ++i) work[i] = hess[i];
             for (int a = 0; a < dim; ++a) work[a * dim + a] += mu;
             factored = cholesky(work, dim, 0.0);
@@ -359,7 +359,7 @@ ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, i
       }
     }
     double longest = 0.0;
-    for (int k = 0; k < n; ++k) longest = fmax(longest, hypot(step[2 * k], step[2 * k + 1]));
+    for (int k = 0; k < n; ++k) longest = larger(longest, hypot(step[2 * k], step[2 * k + 1]));
     double t = longest > 0.5 ? 0.5 / longest : 1.0;
     const double e0 = cell_free_energy(p, H_A, m);
     bool accepted = false;
@@ -390,7 +390,7 @@ ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, i
 // converges this moves M by round-off only.
 ODEMAG_HD void isotropic_minimum(const SoftCellParams& p, const Vec3& H_A, Vec3* m) {
   const double h = norm(H_A);
-  const double t = fmin(h / (p.gamma_D * p.Ms), 1.0), s = sqrt(fmax(0.0, 1.0 - t * t));
+  const double t = fmin(h / (p.gamma_D * p.Ms), 1.0), s = sqrt(larger(0.0, 1.0 - t * t));
   const Vec3 dir = h > 0.0 ? (1.0 / h) * H_A : Vec3{};
   for (int j = 0; j + 1 < p.n; j += 2) {
     Vec3 axis = m[j] - m[j + 1];
