@@ -11,8 +11,9 @@
 // (likewise for y = 0). The mean field over cell i is
 //   H_i = -sum_j K_ij M_j,   K_ij = sum_s N_ij(c_i - P_s c_j) S_s          (1)
 // over the images s (the identity included), N_ij the cell-averaged tensor
-// of cuboid i and cuboid j (cuboid_demag_tensor). K is stored dense (3N x
-// 3N); V_j K_ji = V_i K_ij^T, so half of it is computed.
+// of cuboid i and cuboid j (cuboid_demag_tensor). V_j K_ji = V_i K_ij^T, so
+// S = V K is symmetric: half of it is computed, stored dense (3N x 3N, lower
+// triangle) and read per field.
 //
 // The force on all images of a set T of cells from all images of a set S:
 //   F_q = -mu0 sum_{i in T} V_i sum_{j in S} sum_s M_i^T dN_ij/dd (c_i - P_s c_j) S_s M_j   (2)
@@ -61,9 +62,12 @@ class CuboidDemag : public DemagOperator {
   const std::vector<Vec3>& images() const { return images_; }
 
  private:
+  // N of cell i and the image s of cell j (1); with dn, also its gradient (2).
+  void pair_tensor(int i, int j, int s, double n[6], double (*dn)[6] = nullptr) const;
+
   std::vector<CuboidCell> cells_;
   std::vector<Vec3> images_;
-  Eigen::MatrixXd K_;
+  Eigen::MatrixXd S_;  // V_i K_ij (1), symmetric: only its lower triangle is set
 };
 
 }  // namespace odemag

@@ -5,12 +5,16 @@
 // field), and the B-H solve on a quarter against the same solve on the whole.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
 #include "magnetics/bh_curve.h"
 #include "magnetics/bh_lattice_solve.h"
+#include "magnetics/constants.h"
 #include "magnetics/cuboid_demag.h"
+#include "magnetics/demag_tensor.h"
+#include "magnetics/kernels.h"
 #include "magnetics/rng.h"
 
 namespace odemag {
@@ -112,6 +116,68 @@ TEST(CuboidDemag, BhSolveOnTheQuarterEqualsTheSolveOnTheWhole) {
   double scale = 0.0;
   for (const Vec3& m : Mw) scale = std::max(scale, norm(m));
   for (int i = 0; i < n; ++i) EXPECT_LT(norm(Mq[i] - Mw[i]), 1e-8 * scale) << i;
+}
+
+TEST(CuboidDemag, RepeatedPairsEqualTheDirectSum) {
+  // A uniform grid of 1/3 mm cells (centres with rounding: the pairs at one
+  // lattice offset share a tensor only through the keys' tolerance) beside
+  // a block of another size: the field and the force from the stored
+  // distinct pairs against the sum of cuboid_demag_tensor over every cell
+  // and image, written here.
+  std::vector<double> fx, fy, fz;
+  for (int k = 0; k <= 4; ++k) fx.push_back(k * 1e-3 / 3.0);
+  for (int k = 0; k <= 3; ++k) fy.push_back(k * 1e-3 / 3.0);
+  for (int k = 0; k <= 5; ++k) fz.push_back(-1e-3 + k * 1e-3 / 3.0);
+  std::vector<CuboidCell> cells = grid_cells(fx, fy, fz);
+  const int grid = static_cast<int>(cells.size());
+  cells.push_back({1e-3 * Vec3{0.5, 0.4, 0.9}, 1e-3 * Vec3{0.3, 0.2, 0.15}});  // above the grid
+  const int n = static_cast<int>(cells.size());
+  const CuboidDemag demag(cells, true, true);
+  std::vector<Vec3> M(n);
+  for (int i = 0; i < n; ++i) M[i] = 1e6 * random_unit_vector(hash_key(5, i, 0, 0));
+  std::vector<Vec3> H;
+  demag.field(M, H);
+  auto pair = [&](int i, int j, const Vec3& s, double t[6], double (*dt)[6]) {
+    const double ha[3] = {cells[i].half.x, cells[i].half.y, cells[i].half.z};
+    const double hb[3] = {cells[j].half.x, cells[j].half.y, cells[j].half.z};
+    const Vec3 d = cells[i].centre - reflect(s, cells[j].centre);
+    const double dd[3] = {d.x, d.y, d.z};
+    cuboid_demag_tensor(ha, hb, dd, t, dt);
+  };
+  double scale = 0.0;
+  for (const Vec3& h : H) scale = std::max(scale, norm(h));
+  for (int i = 0; i < n; ++i) {
+    Vec3 direct{};
+    for (int j = 0; j < n; ++j)
+      for (const Vec3& s : demag.images()) {
+        double t[6];
+        pair(i, j, s, t, nullptr);
+        direct -= symmetric_times(t, reflect(s, M[j]));
+      }
+    EXPECT_LT(norm(H[i] - direct), 1e-12 * scale) << "cell " << i;
+  }
+  // Forces, (2) of cuboid_demag.h: on the grid's two lower layers from its
+  // three upper ones (pairs that repeat: the table) and on the grid from the
+  // block (every pair distinct: evaluated one by one).
+  auto direct_force = [&](int t0, int t1, int s0, int s1) {
+    Vec3 quarter{};
+    for (int i = t0; i < t1; ++i)
+      for (int j = s0; j < s1; ++j)
+        for (const Vec3& s : demag.images()) {
+          double t[6], dt[3][6];
+          pair(i, j, s, t, dt);
+          for (int k = 0; k < 3; ++k)
+            quarter[k] -= kMu0 * demag.volume(i) * dot(M[i], symmetric_times(dt[k], reflect(s, M[j])));
+        }
+    Vec3 total{};
+    for (const Vec3& s : demag.images()) total += reflect(s, quarter);
+    return total;
+  };
+  const int layer = 4 * 3;
+  for (const std::array<int, 4>& r : {std::array<int, 4>{0, 2 * layer, 2 * layer, grid}, {0, grid, grid, n}}) {
+    const Vec3 F_direct = direct_force(r[0], r[1], r[2], r[3]);
+    EXPECT_LT(norm(demag.force(r[0], r[1], r[2], r[3], M) - F_direct), 1e-12 * norm(F_direct)) << r[1];
+  }
 }
 
 TEST(CuboidDemag, RefusesCellsAcrossAMirrorPlane) {
