@@ -33,11 +33,13 @@ Vec3 reflect(const Vec3& s, const Vec3& v) { return {s.x * v.x, s.y * v.y, s.z *
 // lattice offset differ by rounding), which moves a tensor by about that
 // share of itself at most.
 constexpr double kSameValue = 1e-9;
-constexpr int kAxisBits = 21;  // per axis, at most 2^21 distinct triples
+constexpr int kAxisBits = 21;      // per axis, at most 2^21 distinct triples
+constexpr int kMaxColumns = 1024;  // per axis; more: no table (cells that share few planes)
 
 class PairKeys {
  public:
-  PairKeys(const std::vector<CuboidCell>& cells, const std::vector<Vec3>& images) : images_(static_cast<int>(images.size())) {
+  PairKeys(const std::vector<CuboidCell>& cells, const std::vector<Vec3>& images)
+      : images_(static_cast<int>(images.size())) {
     double smallest = std::numeric_limits<double>::infinity();
     for (const CuboidCell& c : cells) smallest = std::min({smallest, c.half.x, c.half.y, c.half.z});
     const double q = kSameValue * smallest;
@@ -48,31 +50,39 @@ class PairKeys {
       column_[a].resize(cells.size());
       for (size_t i = 0; i < cells.size(); ++i) {
         const double centre = cells[i].centre[a], half = cells[i].half[a];
-        const auto inserted = columns.emplace(std::make_pair(quantum(centre), quantum(half)), static_cast<int>(columns.size()));
+        const auto inserted =
+            columns.emplace(std::make_pair(quantum(centre), quantum(half)), static_cast<int>(columns.size()));
         if (inserted.second) column_values.emplace_back(centre, half);
         column_[a][i] = inserted.first->second;
       }
       const int n = static_cast<int>(column_values.size());
       columns_[a] = n;
+      if (n > kMaxColumns) {
+        usable_ = false;
+        return;
+      }
       std::map<std::array<long long, 3>, int> triples;
       triple_[a].resize(static_cast<size_t>(n) * n * images_);
       for (int ca = 0; ca < n; ++ca)
         for (int cb = 0; cb < n; ++cb)
           for (int s = 0; s < images_; ++s) {
             const double d = column_values[ca].first - images[s][a] * column_values[cb].first;
-            const std::array<long long, 3> t{quantum(column_values[ca].second), quantum(column_values[cb].second), quantum(d)};
-            triple_[a][(static_cast<size_t>(ca) * n + cb) * images_ + s] = triples.emplace(t, static_cast<int>(triples.size())).first->second;
+            const std::array<long long, 3> t{quantum(column_values[ca].second),
+                                             quantum(column_values[cb].second), quantum(d)};
+            triple_[a][(static_cast<size_t>(ca) * n + cb) * images_ + s] =
+                triples.emplace(t, static_cast<int>(triples.size())).first->second;
           }
       if (triples.size() >= (1u << kAxisBits)) usable_ = false;
     }
   }
-  // false: too many distinct triples along an axis for the packed key.
+  // false: too many columns or distinct triples along an axis for the table.
   bool usable() const { return usable_; }
   uint64_t key(int i, int j, int s) const {
     uint64_t k = 0;
-    for (int a = 0; a < 3; ++a)
-      k = (k << kAxisBits) |
-          static_cast<uint64_t>(triple_[a][(static_cast<size_t>(column_[a][i]) * columns_[a] + column_[a][j]) * images_ + s]);
+    for (int a = 0; a < 3; ++a) {
+      const size_t slot = (static_cast<size_t>(column_[a][i]) * columns_[a] + column_[a][j]) * images_ + s;
+      k = (k << kAxisBits) | static_cast<uint64_t>(triple_[a][slot]);
+    }
     return k;
   }
 
@@ -102,7 +112,8 @@ DistinctPairs distinct_pairs(const PairKeys& keys, long total, EachPair each_pai
   const size_t limit = static_cast<size_t>(total / 2);
   each_pair([&](int i, int j, int s) {
     if (!d.valid) return;
-    if (d.index.emplace(keys.key(i, j, s), static_cast<int>(d.first.size())).second) d.first.push_back({i, j, s});
+    const int next = static_cast<int>(d.first.size());
+    if (d.index.emplace(keys.key(i, j, s), next).second) d.first.push_back({i, j, s});
     if (d.first.size() > limit) d = DistinctPairs{};
   });
   return d;
