@@ -508,7 +508,6 @@ class BallLatticeNearField final : public NearFieldTerm {
         }
       }
     }
-    couplings_.clear();
     for_each_pair([&](const BallCellPair& p) {
       PairCoupling k{p.b, p.c, p.responsive_b, p.responsive_c, p.volume_b, p.volume_c, {}};
       std::copy(p.K, p.K + 6, k.K);

@@ -94,28 +94,39 @@ class PairKeys {
   std::array<std::vector<int>, 3> triple_;  // per axis: (column a, column b, image) -> triple
 };
 
-// The distinct pairs among those (i, j, image) that each_pair(visit)
-// visits, numbered in the order first met, with one representative each.
-// Given up (valid false, nothing kept) once more than half of the `total`
-// visited are distinct: evaluating every pair then costs less than the table
-// (the 5 mm TEAM 20 grid's force: 152,400 distinct of 158,400).
+// The pairs (i, j) with i in [i0, i1) and j in [j0, j1), only those with
+// j >= i where `from_i`, each with every image.
+struct PairRange {
+  int i0, i1, j0, j1;
+  bool from_i;
+  int first_j(int i) const { return from_i ? std::max(i, j0) : j0; }
+};
+
+// The distinct pairs (i, j, image) of a range, numbered in the order first
+// met, with one representative each. Given up (valid false, nothing kept)
+// once more than half of the range's pairs are distinct: evaluating every
+// pair then costs less than the table (the 5 mm TEAM 20 grid's force:
+// 152,400 distinct of 158,400).
 struct DistinctPairs {
   bool valid = false;
   std::unordered_map<uint64_t, int> index;
   std::vector<std::array<int, 3>> first;  // i, j, image
 };
 
-template <class EachPair>
-DistinctPairs distinct_pairs(const PairKeys& keys, long total, EachPair each_pair) {
+DistinctPairs distinct_pairs(const PairKeys& keys, const PairRange& r, int image_count) {
+  long total = 0;
+  for (int i = r.i0; i < r.i1; ++i) total += std::max(0, r.j1 - r.first_j(i));
+  const size_t limit = static_cast<size_t>(total * image_count / 2);
   DistinctPairs d;
-  d.valid = keys.usable();
-  const size_t limit = static_cast<size_t>(total / 2);
-  each_pair([&](int i, int j, int s) {
-    if (!d.valid) return;
-    const int next = static_cast<int>(d.first.size());
-    if (d.index.emplace(keys.key(i, j, s), next).second) d.first.push_back({i, j, s});
-    if (d.first.size() > limit) d = DistinctPairs{};
-  });
+  if (!keys.usable()) return d;
+  for (int i = r.i0; i < r.i1; ++i)
+    for (int j = r.first_j(i); j < r.j1; ++j)
+      for (int s = 0; s < image_count; ++s) {
+        const int next = static_cast<int>(d.first.size());
+        if (d.index.emplace(keys.key(i, j, s), next).second) d.first.push_back({i, j, s});
+        if (d.first.size() > limit) return {};
+      }
+  d.valid = true;
   return d;
 }
 
@@ -148,12 +159,7 @@ CuboidDemag::CuboidDemag(std::vector<CuboidCell> cell_list, bool mirror_x, bool 
   const int image_count = static_cast<int>(images_.size());
   // The distinct pairs of j >= i (repeated pairs, above), their tensors once each.
   const PairKeys keys(cells_, images_);
-  const DistinctPairs distinct =
-      distinct_pairs(keys, static_cast<long>(N) * (N + 1) / 2 * image_count, [&](const auto& visit) {
-        for (int i = 0; i < N; ++i)
-          for (int j = i; j < N; ++j)
-            for (int s = 0; s < image_count; ++s) visit(i, j, s);
-      });
+  const DistinctPairs distinct = distinct_pairs(keys, {0, N, 0, N, true}, image_count);
   std::vector<std::array<double, 6>> tensor(distinct.first.size());
 #pragma omp parallel for schedule(dynamic, 64)
   for (long p = 0; p < static_cast<long>(tensor.size()); ++p) {
@@ -208,12 +214,7 @@ Vec3 CuboidDemag::force(int t0, int t1, int s0, int s1, const std::vector<Vec3>&
   const int image_count = static_cast<int>(images_.size());
   // The gradients of the distinct pairs once each (repeated pairs, above).
   const PairKeys keys(cells_, images_);
-  const DistinctPairs distinct =
-      distinct_pairs(keys, static_cast<long>(t1 - t0) * (s1 - s0) * image_count, [&](const auto& visit) {
-        for (int i = t0; i < t1; ++i)
-          for (int j = s0; j < s1; ++j)
-            for (int s = 0; s < image_count; ++s) visit(i, j, s);
-      });
+  const DistinctPairs distinct = distinct_pairs(keys, {t0, t1, s0, s1, false}, image_count);
   std::vector<std::array<double, 18>> gradient(distinct.first.size());
 #pragma omp parallel for schedule(dynamic, 64)
   for (long p = 0; p < static_cast<long>(gradient.size()); ++p) {
