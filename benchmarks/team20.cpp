@@ -7,14 +7,15 @@
 //
 // Usage: team20 [--out DIR] [--h 5,2.5x2.5x5,2.5] [--graded 2.5/1.5/10,...]
 //               [--graded-name STEM] [--ampere-turns 1000,...] [--threads T]
-//               [--newton-variable flux|field]
+//               [--newton-variable flux|field] [--dense]
 // (--h: FFT lattices of edge h, or edges hx x hy x hz, in mm, written to
 // DIR/team20.csv and .md; --graded: the quarter model with mirror planes and
 // graded cells h_min/growth/h_max (mm; growth 1: uniform),
 // team20::GradedProblem, written to DIR/STEM.csv and .md, only when given,
 // STEM team20_graded unless --graded-name says otherwise; --ampere-turns: a
 // subset of the four excitations; the Newton variable b = H + M, the
-// default, or H: magnetics/bh_lattice_solve.h).
+// default, or H: magnetics/bh_lattice_solve.h; --dense: the quarter's
+// operator stored dense instead of as a hierarchical matrix).
 // DIR: benchmarks/results. Runs itself again with OMP_WAIT_POLICY=passive
 // when that is unset.
 #include <omp.h>
@@ -112,6 +113,7 @@ int main(int argc, char** argv) {
   int threads = 2;
   std::vector<double> excitations;  // empty: the four measured
   BhNewtonVariable variable = BhNewtonVariable::flux_density;
+  bool dense = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out") {
@@ -133,10 +135,12 @@ int main(int argc, char** argv) {
     } else if (a == "--newton-variable" && i + 1 < argc &&
                (std::string(argv[i + 1]) == "flux" || std::string(argv[i + 1]) == "field")) {
       variable = std::string(argv[++i]) == "flux" ? BhNewtonVariable::flux_density : BhNewtonVariable::field;
+    } else if (a == "--dense") {
+      dense = true;
     } else {
       std::fprintf(stderr,
                    "usage: team20 [--out DIR] [--h 5,2.5x2.5x5,...] [--graded h_min/growth/h_max,...] [--graded-name STEM] "
-                   "[--ampere-turns 1000,...] [--threads T] [--newton-variable flux|field]\n");
+                   "[--ampere-turns 1000,...] [--threads T] [--newton-variable flux|field] [--dense]\n");
       return 2;
     }
   }
@@ -204,14 +208,16 @@ int main(int argc, char** argv) {
                "# TEAM 20 on graded cells with mirror planes\n\n"
                "benchmarks/team20 --graded (docs/validation.md \"TEAM 20\"), " + thread_count +
                    " The quarter x, y >= 0 with its images in x = 0 and y = 0, cells h_min at the refined faces growing by "
-                   "`growth` per cell up to h_max (team20::GradedProblem), the dense sum of magnetics/cuboid_demag.h." +
+                   "`growth` per cell up to h_max (team20::GradedProblem), the sum of magnetics/cuboid_demag.h stored " +
+                   (dense ? "dense" : "as a hierarchical matrix (magnetics/hmatrix.h)") +
+                   ", the forces by stored bilinear forms (setup)." +
                    solve_line + " Cells: the whole problem's (four times the unknown cells).\n\n"
                    "| h_min / growth / h_max (mm) | cells | unknown cells |",
                [&](FILE* csv, FILE* md) {
                  for (const std::string& spec : gradings) {
                    const team20::Grading g = grading(spec);
                    const auto t0 = std::chrono::steady_clock::now();
-                   const team20::GradedProblem p(g, true);
+                   const team20::GradedProblem p(g, true, !dense);
                    const double setup = seconds_since(t0);
                    solve_excitations(p, {spec, g.h_min, g.growth, g.h_max, p.full_cells(), 4 * p.pole_cells, p.demag.cells(),
                                          threads, setup, 0.0},

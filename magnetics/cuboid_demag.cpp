@@ -201,18 +201,48 @@ void CuboidDemag::field(const std::vector<Vec3>& M, std::vector<Vec3>& H) const 
   Eigen::Map<const Eigen::VectorXd> m(&M[0].x, 3 * N);
   Eigen::Map<Eigen::VectorXd> h(&H[0].x, 3 * N);
   // H = -K M = -V^-1 S M, S read from its lower triangle (half the bytes of K).
-  h.noalias() = S_.selfadjointView<Eigen::Lower>() * m;
+  if (compressed_) {
+    Eigen::VectorXd y;
+    compressed_->multiply(m, y);
+    h = y;
+  } else {
+    h.noalias() = S_.selfadjointView<Eigen::Lower>() * m;
+  }
   for (int i = 0; i < N; ++i) H[i] = (-1.0 / volume(i)) * H[i];
 }
 
+void CuboidDemag::compress(const HMatrixOptions& options) {
+  if (compressed_) return;
+  const int N = cells();
+  std::vector<HMatrix::CellBox> boxes(N);
+  self_.resize(N);
+  for (int i = 0; i < N; ++i) {
+    boxes[i] = {cells_[i].centre, cells_[i].half};
+    self_[i] = S_.block<3, 3>(3 * i, 3 * i) / volume(i);
+  }
+  self_.resize(N);
+  compressed_ = std::make_shared<const HMatrix>(
+      boxes, images_, [this](int r, int c) { return r >= c ? S_(r, c) : S_(c, r); }, options);
+  S_ = Eigen::MatrixXd();
+}
+
 void CuboidDemag::self_block(int cell, double n[6]) const {
-  const auto k = S_.block<3, 3>(3 * cell, 3 * cell) / volume(cell);
+  const Eigen::Matrix3d k = compressed_ ? self_[cell] : Eigen::Matrix3d(S_.block<3, 3>(3 * cell, 3 * cell) / volume(cell));
   n[0] = k(0, 0), n[1] = k(1, 0), n[2] = k(2, 0), n[3] = k(1, 1), n[4] = k(2, 1), n[5] = k(2, 2);
 }
 
 Vec3 CuboidDemag::force(int t0, int t1, int s0, int s1, const std::vector<Vec3>& M) const {
+  return force_operator(t0, t1, s0, s1)(M);
+}
+
+CuboidDemag::ForceOperator CuboidDemag::force_operator(int t0, int t1, int s0, int s1) const {
   const int image_count = static_cast<int>(images_.size());
-  // The gradients of the distinct pairs once each (repeated pairs, above).
+  ForceOperator op;
+  op.t0_ = t0;
+  op.s0_ = s0;
+  for (const Vec3& s : images_) op.image_sum_ += s;
+  for (int k = 0; k < 3; ++k)
+    if (op.image_sum_[k] != 0.0) op.G_[k] = Eigen::MatrixXd::Zero(3 * (t1 - t0), 3 * (s1 - s0));
   const PairKeys keys(cells_, images_);
   const DistinctPairs distinct = distinct_pairs(keys, {t0, t1, s0, s1, false}, image_count);
   std::vector<std::array<double, 18>> gradient(distinct.first.size());
@@ -222,9 +252,8 @@ Vec3 CuboidDemag::force(int t0, int t1, int s0, int s1, const std::vector<Vec3>&
     double n[6];
     pair_tensor(i, j, s, n, reinterpret_cast<double(*)[6]>(gradient[p].data()));
   }
-  Vec3 F{};
+#pragma omp parallel for schedule(dynamic, 4)
   for (int i = t0; i < t1; ++i) {
-    Vec3 Fi{};
     for (int j = s0; j < s1; ++j) {
       for (int s = 0; s < image_count; ++s) {
         double n[6], own[3][6];
@@ -233,15 +262,26 @@ Vec3 CuboidDemag::force(int t0, int t1, int s0, int s1, const std::vector<Vec3>&
           dn = reinterpret_cast<const double(*)[6]>(gradient[distinct.index.at(keys.key(i, j, s))].data());
         else
           pair_tensor(i, j, s, n, own);
-        const Vec3 Mj = reflect(images_[s], M[j]);
-        for (int k = 0; k < 3; ++k) Fi[k] -= dot(M[i], symmetric_times(dn[k], Mj));
+        const Eigen::Vector3d reflection(images_[s].x, images_[s].y, images_[s].z);
+        for (int k = 0; k < 3; ++k)
+          if (op.G_[k].size() > 0)
+            op.G_[k].block<3, 3>(3 * (i - t0), 3 * (j - s0)) -=
+                (kMu0 * volume(i)) * symmetric_matrix(dn[k]) * reflection.asDiagonal();
       }
     }
-    F += (kMu0 * volume(i)) * Fi;
   }
-  Vec3 total{};
-  for (const Vec3& s : images_) total += reflect(s, F);
-  return total;
+  return op;
+}
+
+Vec3 CuboidDemag::ForceOperator::operator()(const std::vector<Vec3>& M) const {
+  Vec3 F{};
+  for (int k = 0; k < 3; ++k) {
+    if (G_[k].size() == 0) continue;
+    const Eigen::Map<const Eigen::VectorXd> target(&M[t0_].x, G_[k].rows());
+    const Eigen::Map<const Eigen::VectorXd> source(&M[s0_].x, G_[k].cols());
+    F[k] = image_sum_[k] * target.dot(G_[k] * source);  // (2), summed over the images' reflections
+  }
+  return F;
 }
 
 Vec3 CuboidDemag::field_at(const Vec3& point, const std::vector<Vec3>& M) const {

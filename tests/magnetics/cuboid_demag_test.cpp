@@ -177,6 +177,29 @@ TEST(CuboidDemag, RepeatedPairsEqualTheDirectSum) {
   for (const std::array<int, 4>& r : {std::array<int, 4>{0, 2 * layer, 2 * layer, grid}, {0, grid, grid, n}}) {
     const Vec3 F_direct = direct_force(r[0], r[1], r[2], r[3]);
     EXPECT_LT(norm(demag.force(r[0], r[1], r[2], r[3], M) - F_direct), 1e-12 * norm(F_direct)) << r[1];
+    EXPECT_LT(norm(demag.force_operator(r[0], r[1], r[2], r[3])(M) - F_direct), 1e-12 * norm(F_direct)) << r[1];
+  }
+}
+
+TEST(CuboidDemag, ForceOperatorEqualsTheForce) {
+  // One mirror plane or none (components the images do not cancel), for two
+  // magnetizations on one operator.
+  const std::vector<CuboidCell> cells = quarter_cells();
+  const int n = static_cast<int>(cells.size());
+  for (const bool mirror : {false, true}) {
+    const CuboidDemag demag(cells, mirror, false);
+    const CuboidDemag::ForceOperator on_block = demag.force_operator(n - 1, n, 0, n - 1);
+    for (int seed = 0; seed < 2; ++seed) {
+      std::vector<Vec3> M(n);
+      for (int i = 0; i < n; ++i) M[i] = 1e6 * random_unit_vector(hash_key(7, i, seed, 0));
+      const Vec3 F = demag.force(n - 1, n, 0, n - 1, M);
+      const Vec3 G = on_block(M);
+      EXPECT_GT(norm(F), 0.0);
+      EXPECT_LT(norm(G - F), 1e-12 * norm(F)) << mirror << " " << seed;
+      if (mirror) {
+        EXPECT_EQ(G.x, 0.0);
+      }
+    }
   }
 }
 

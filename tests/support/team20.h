@@ -287,6 +287,7 @@ struct GradedProblem {
   bool balance = false;
   int pole_cells = 0;  // the pole's cells come first
   CuboidDemag demag;
+  CuboidDemag::ForceOperator force_from_yoke, force_on_yoke;  // (2) of magnetics/cuboid_demag.h
   std::vector<Vec3> coil_H;                        // at 1 A-turn, at the cell centres
   std::vector<std::array<Vec3, 3>> coil_gradient;  // pole cells: d(coil_H)/dx_a, 1 A-turn
   BhCurve curve{bh_table()};
@@ -320,11 +321,17 @@ struct GradedProblem {
   }
 
   // balance: also the forces on the yoke from the pole (the momentum check).
-  explicit GradedProblem(const Grading& g, bool with_balance = false)
+  // compress: the operator as a hierarchical matrix (magnetics/hmatrix.h),
+  // else dense.
+  explicit GradedProblem(const Grading& g, bool with_balance = false, bool compress = true)
       : grading(g), balance(with_balance), demag(make(g, pole_cells), true, true) {
     std::vector<Vec3> centres(demag.cells());
     for (int i = 0; i < demag.cells(); ++i) centres[i] = demag.cell(i).centre;
     unit_coil_fields(centres, pole_cells, 1e-2 * kMm * g.h_min, coil_H, coil_gradient);
+    const int N = demag.cells();
+    force_from_yoke = demag.force_operator(0, pole_cells, pole_cells, N);
+    if (balance) force_on_yoke = demag.force_operator(pole_cells, N, 0, pole_cells);
+    if (compress) demag.compress();
   }
   // All cells of the whole problem (the quarter's times four).
   int full_cells() const { return 4 * demag.cells(); }
@@ -337,8 +344,8 @@ inline Result solve(const GradedProblem& p, double ampere_turns, std::vector<Vec
   Result r;
   const std::vector<double> fill(N, 1.0);
   r.report = solve_bh_lattice(p.demag, p.curve, fill, source, M, options);
-  r.force_from_yoke = p.demag.force(0, p.pole_cells, p.pole_cells, N, M);
-  if (p.balance) r.force_on_yoke = p.demag.force(p.pole_cells, N, 0, p.pole_cells, M);
+  r.force_from_yoke = p.force_from_yoke(M);
+  if (p.balance) r.force_on_yoke = p.force_on_yoke(M);
   // The coil's part on the quarter's pole cells, then on all four images.
   Vec3 quarter{};
   for (int i = 0; i < p.pole_cells; ++i)
