@@ -7,7 +7,7 @@
 //
 // Usage: team20 [--out DIR] [--h 5,2.5x2.5x5,2.5] [--graded 2.5/1.5/10,...]
 //               [--graded-name STEM] [--ampere-turns 1000,...] [--threads T]
-//               [--newton-variable flux|field] [--dense]
+//               [--newton-variable flux|field] [--dense | --single] [--tolerance T]
 // (--h: FFT lattices of edge h, or edges hx x hy x hz, in mm, written to
 // DIR/team20.csv and .md; --graded: the quarter model with mirror planes and
 // graded cells h_min/growth/h_max (mm; growth 1: uniform),
@@ -15,7 +15,10 @@
 // STEM team20_graded unless --graded-name says otherwise; --ampere-turns: a
 // subset of the four excitations; the Newton variable b = H + M, the
 // default, or H: magnetics/bh_lattice_solve.h; --dense: the quarter's
-// operator stored dense instead of as a hierarchical matrix).
+// operator stored dense instead of as a hierarchical matrix, --single: the
+// hierarchical matrix in single precision; --tolerance:
+// the solve's, on |G| / |M| of magnetics/bh_lattice_solve.h, 1e-4 unless
+// given).
 // DIR: benchmarks/results. Runs itself again with OMP_WAIT_POLICY=passive
 // when that is unset.
 #include <omp.h>
@@ -113,7 +116,8 @@ int main(int argc, char** argv) {
   int threads = 2;
   std::vector<double> excitations;  // empty: the four measured
   BhNewtonVariable variable = BhNewtonVariable::flux_density;
-  bool dense = false;
+  auto storage = team20::GradedProblem::Storage::compressed;
+  double tolerance = 1e-4;  // the force is then converged to 5 digits (docs/validation.md "TEAM 20")
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--out") {
@@ -136,11 +140,23 @@ int main(int argc, char** argv) {
                (std::string(argv[i + 1]) == "flux" || std::string(argv[i + 1]) == "field")) {
       variable = std::string(argv[++i]) == "flux" ? BhNewtonVariable::flux_density : BhNewtonVariable::field;
     } else if (a == "--dense") {
-      dense = true;
+      storage = team20::GradedProblem::Storage::dense;
+    } else if (a == "--single") {
+      storage = team20::GradedProblem::Storage::compressed_single;
+    } else if (a == "--tolerance") {
+      try {
+        tolerance = std::stod(bench::option_value(argc, argv, i, "team20"));
+      } catch (const std::exception&) {
+        tolerance = 0.0;
+      }
+      if (!(tolerance > 0.0 && tolerance < 1.0)) {
+        std::fprintf(stderr, "team20: --tolerance wants a number in (0, 1)\n");
+        return 2;
+      }
     } else {
       std::fprintf(stderr,
                    "usage: team20 [--out DIR] [--h 5,2.5x2.5x5,...] [--graded h_min/growth/h_max,...] [--graded-name STEM] "
-                   "[--ampere-turns 1000,...] [--threads T] [--newton-variable flux|field] [--dense]\n");
+                   "[--ampere-turns 1000,...] [--threads T] [--newton-variable flux|field] [--dense | --single] [--tolerance T]\n");
       return 2;
     }
   }
@@ -152,7 +168,7 @@ int main(int argc, char** argv) {
     }
   omp_set_num_threads(threads);
   BhSolveOptions options;
-  options.tolerance = 1e-4;  // the force is then converged to 5 digits (docs/validation.md "TEAM 20")
+  options.tolerance = tolerance;
   options.variable = variable;
   auto wanted = [&](const team20::Measured& m) {
     return excitations.empty() || std::find(excitations.begin(), excitations.end(), m.ampere_turns) != excitations.end();
@@ -185,7 +201,10 @@ int main(int argc, char** argv) {
     std::fclose(md);
     return true;
   };
-  const std::string solve_line = std::string(" Solve: Newton-GMRES in ") + newton + " from M = 0, tolerance 1e-4.";
+  char tolerance_text[32];
+  std::snprintf(tolerance_text, sizeof tolerance_text, "%g", tolerance);
+  const std::string solve_line =
+      std::string(" Solve: Newton-GMRES in ") + newton + " from M = 0, tolerance " + tolerance_text + ".";
   const std::string thread_count = std::to_string(threads) + " thread(s).";
   if (!hs.empty() &&
       !reports("team20", "hx_mm,hy_mm,hz_mm,cells,pole_cells,",
@@ -209,7 +228,11 @@ int main(int argc, char** argv) {
                "benchmarks/team20 --graded (docs/validation.md \"TEAM 20\"), " + thread_count +
                    " The quarter x, y >= 0 with its images in x = 0 and y = 0, cells h_min at the refined faces growing by "
                    "`growth` per cell up to h_max (team20::GradedProblem), the sum of magnetics/cuboid_demag.h stored " +
-                   (dense ? "dense" : "as a hierarchical matrix (magnetics/hmatrix.h)") +
+                   (storage == team20::GradedProblem::Storage::dense
+                        ? "dense"
+                        : storage == team20::GradedProblem::Storage::compressed
+                              ? "as a hierarchical matrix (magnetics/hmatrix.h)"
+                              : "as a hierarchical matrix (magnetics/hmatrix.h) in single precision") +
                    ", the forces by stored bilinear forms (setup)." +
                    solve_line + " Cells: the whole problem's (four times the unknown cells).\n\n"
                    "| h_min / growth / h_max (mm) | cells | unknown cells |",
@@ -217,7 +240,7 @@ int main(int argc, char** argv) {
                  for (const std::string& spec : gradings) {
                    const team20::Grading g = grading(spec);
                    const auto t0 = std::chrono::steady_clock::now();
-                   const team20::GradedProblem p(g, true, !dense);
+                   const team20::GradedProblem p(g, true, storage);
                    const double setup = seconds_since(t0);
                    solve_excitations(p, {spec, g.h_min, g.growth, g.h_max, p.full_cells(), 4 * p.pole_cells, p.demag.cells(),
                                          threads, setup, 0.0},

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numeric>
 
 namespace odemag {
@@ -32,13 +31,37 @@ HMatrix::HMatrix(const std::vector<CellBox>& cells, const std::vector<Vec3>& ima
   if (cells.empty()) return;
   split(0, static_cast<int>(cells.size()), cells);
   partition(0, 0, entry);
-  for (DenseBlock& d : dense_) {
+  for (const DenseBlock& d : dense_) {
     const Cluster& r = clusters_[d.rows];
     const Cluster& c = clusters_[d.cols];
-    d.a.resize(3 * (r.end - r.begin), 3 * (c.end - c.begin));
-    for (int i = 0; i < d.a.rows(); ++i)
-      for (int j = 0; j < d.a.cols(); ++j)
-        d.a(i, j) = entry(3 * order_[r.begin + i / 3] + i % 3, 3 * order_[c.begin + j / 3] + j % 3);
+    Eigen::MatrixXd a(3 * (r.end - r.begin), 3 * (c.end - c.begin));
+    for (int i = 0; i < a.rows(); ++i)
+      for (int j = 0; j < a.cols(); ++j)
+        a(i, j) = entry(3 * order_[r.begin + i / 3] + i % 3, 3 * order_[c.begin + j / 3] + j % 3);
+    double_.dense.push_back(std::move(a));
+  }
+  // The chunks of multiply: blocks (dense first, then low-rank) in runs of
+  // about equal stored numbers.
+  const long total = stored();
+  long sum = 0;
+  int chunk = 1;
+  const int blocks = static_cast<int>(dense_.size() + low_rank_.size());
+  chunk_begin_.fill(blocks);
+  chunk_begin_[0] = 0;
+  for (int k = 0; k < blocks && chunk < kChunks; ++k) {
+    const int d = static_cast<int>(dense_.size());
+    sum += k < d ? static_cast<long>(double_.dense[k].size())
+                 : static_cast<long>(double_.u[k - d].size() + double_.v[k - d].size());
+    if (sum * kChunks >= chunk * total) chunk_begin_[chunk++] = k + 1;
+  }
+  if (options_.single_precision) {
+    auto to_single = [](std::vector<Eigen::MatrixXd>& from, std::vector<Eigen::MatrixXf>& to) {
+      for (const Eigen::MatrixXd& m : from) to.push_back(m.cast<float>());
+      from = {};
+    };
+    to_single(double_.dense, single_.dense);
+    to_single(double_.u, single_.u);
+    to_single(double_.v, single_.v);
   }
 }
 
@@ -94,7 +117,7 @@ void HMatrix::partition(int a, int b, const std::function<double(int, int)>& ent
   const bool leaf_a = ca.first < 0, leaf_b = cb.first < 0;
   if (a == b) {
     if (leaf_a) {
-      dense_.push_back({a, b, {}});
+      dense_.push_back({a, b});
     } else {
       partition(ca.first, ca.first, entry);
       partition(ca.second, ca.first, entry);
@@ -102,12 +125,15 @@ void HMatrix::partition(int a, int b, const std::function<double(int, int)>& ent
     }
   } else if (far_apart(ca, cb)) {
     Eigen::MatrixXd u, v;
-    if (cross_approximation(ca, cb, entry, u, v))
-      low_rank_.push_back({a, b, std::move(u), std::move(v)});
-    else
-      dense_.push_back({a, b, {}});
+    if (cross_approximation(ca, cb, entry, u, v)) {
+      low_rank_.push_back({a, b});
+      double_.u.push_back(std::move(u));
+      double_.v.push_back(std::move(v));
+    } else {
+      dense_.push_back({a, b});
+    }
   } else if (leaf_a && leaf_b) {
-    dense_.push_back({a, b, {}});
+    dense_.push_back({a, b});
   } else if (leaf_b || (!leaf_a && ca.end - ca.begin >= cb.end - cb.begin)) {
     const int first = ca.first, second = ca.second;
     partition(first, b, entry);
@@ -181,31 +207,60 @@ bool HMatrix::cross_approximation(const Cluster& a, const Cluster& b, const std:
 }
 
 void HMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  if (options_.single_precision)
+    multiply_stored(single_, x, y);
+  else
+    multiply_stored(double_, x, y);
+}
+
+template <class Scalar>
+void HMatrix::multiply_stored(const Stored<Scalar>& stored, const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
   const int N = static_cast<int>(order_.size());
-  Eigen::VectorXd xp(3 * N), yp = Eigen::VectorXd::Zero(3 * N);
-  for (int k = 0; k < N; ++k) xp.segment<3>(3 * k) = x.segment<3>(3 * order_[k]);
-  for (const DenseBlock& d : dense_) {
-    const int r0 = 3 * clusters_[d.rows].begin, c0 = 3 * clusters_[d.cols].begin;
-    yp.segment(r0, d.a.rows()).noalias() += d.a * xp.segment(c0, d.a.cols());
-    if (d.rows != d.cols) yp.segment(c0, d.a.cols()).noalias() += d.a.transpose() * xp.segment(r0, d.a.rows());
+  Vector xp(3 * N);
+  for (int k = 0; k < N; ++k) xp.template segment<3>(3 * k) = x.segment<3>(3 * order_[k]).template cast<Scalar>();
+  // The blocks in kChunks fixed shares of the stored numbers, each summed
+  // into its own vector, the vectors added in order: the same result for any
+  // number of threads.
+  std::array<Vector, kChunks> part;
+  const int dense_count = static_cast<int>(dense_.size());
+#pragma omp parallel for schedule(static, 1)
+  for (int c = 0; c < kChunks; ++c) {
+    Vector& yp = part[c];
+    yp.setZero(3 * N);
+    Vector t;
+    for (int k = chunk_begin_[c]; k < chunk_begin_[c + 1]; ++k) {
+      if (k < dense_count) {
+        const auto& a = stored.dense[k];
+        const int r0 = 3 * clusters_[dense_[k].rows].begin, c0 = 3 * clusters_[dense_[k].cols].begin;
+        yp.segment(r0, a.rows()).noalias() += a * xp.segment(c0, a.cols());
+        if (dense_[k].rows != dense_[k].cols) yp.segment(c0, a.cols()).noalias() += a.transpose() * xp.segment(r0, a.rows());
+      } else {
+        const auto& u = stored.u[k - dense_count];
+        const auto& v = stored.v[k - dense_count];
+        const LowRankBlock& b = low_rank_[k - dense_count];
+        const int r0 = 3 * clusters_[b.rows].begin, c0 = 3 * clusters_[b.cols].begin;
+        t.noalias() = v.transpose() * xp.segment(c0, v.rows());
+        yp.segment(r0, u.rows()).noalias() += u * t;
+        t.noalias() = u.transpose() * xp.segment(r0, u.rows());
+        yp.segment(c0, v.rows()).noalias() += v * t;
+      }
+    }
   }
-  Eigen::VectorXd t;
-  for (const LowRankBlock& b : low_rank_) {
-    const int r0 = 3 * clusters_[b.rows].begin, c0 = 3 * clusters_[b.cols].begin;
-    t.noalias() = b.v.transpose() * xp.segment(c0, b.v.rows());
-    yp.segment(r0, b.u.rows()).noalias() += b.u * t;
-    t.noalias() = b.u.transpose() * xp.segment(r0, b.u.rows());
-    yp.segment(c0, b.v.rows()).noalias() += b.v * t;
-  }
+  for (int c = 1; c < kChunks; ++c) part[0] += part[c];
   y.resize(3 * N);
-  for (int k = 0; k < N; ++k) y.segment<3>(3 * order_[k]) = yp.segment<3>(3 * k);
+  for (int k = 0; k < N; ++k) y.segment<3>(3 * order_[k]) = part[0].template segment<3>(3 * k).template cast<double>();
 }
 
 long HMatrix::stored() const {
-  long doubles = 0;
-  for (const DenseBlock& d : dense_) doubles += static_cast<long>(d.a.size());
-  for (const LowRankBlock& b : low_rank_) doubles += static_cast<long>(b.u.size() + b.v.size());
-  return doubles;
+  long numbers = 0;
+  auto count = [&](const auto& set) {
+    for (const auto* list : {&set.dense, &set.u, &set.v})
+      for (const auto& m : *list) numbers += static_cast<long>(m.size());
+  };
+  count(double_);
+  count(single_);
+  return numbers;
 }
 
 }  // namespace odemag

@@ -1,8 +1,11 @@
 // The compressed operator (magnetics/hmatrix.h, CuboidDemag::compress):
 // its field against the dense sum on cells far enough apart for low-rank
-// blocks, the tolerance controlling the error, and a B-H solve on it
-// against the same solve on the dense operator.
+// blocks, the tolerance controlling the error, the blocks in single
+// precision, the same field bit for bit on one and two threads, and a B-H
+// solve on it against the same solve on the dense operator.
 #include <gtest/gtest.h>
+
+#include <omp.h>
 
 #include <cmath>
 #include <vector>
@@ -67,6 +70,50 @@ TEST(HMatrix, CompressedFieldEqualsTheDenseSum) {
       exact.self_block(i, b);
       for (int c = 0; c < 6; ++c) EXPECT_EQ(a[c], b[c]) << i;
     }
+  }
+}
+
+TEST(HMatrix, SinglePrecisionKeepsTheBlockTolerance) {
+  // The same blocks rounded to single precision: the field within the
+  // blocks' tolerance 1e-5 of the dense sum (about 1e-7 more than in double).
+  const std::vector<CuboidCell> cells = bars();
+  const int n = static_cast<int>(cells.size());
+  std::vector<Vec3> M(n), dense, single, twice;
+  for (int i = 0; i < n; ++i) M[i] = 1e6 * random_unit_vector(hash_key(17, i, 0, 0));
+  const CuboidDemag exact(cells, true, true);
+  exact.field(M, dense);
+  CuboidDemag demag(cells, true, true), in_double(cells, true, true);
+  HMatrixOptions options;
+  in_double.compress(options);
+  options.single_precision = true;
+  demag.compress(options);
+  EXPECT_EQ(demag.compressed()->stored(), in_double.compressed()->stored());
+  demag.field(M, single);
+  in_double.field(M, twice);
+  EXPECT_LT(relative_error(single, dense), 1e-5);
+  const double rounding = relative_error(single, twice);
+  EXPECT_GT(rounding, 0.0);    // it is single precision
+  EXPECT_LT(rounding, 1e-6);
+}
+
+TEST(HMatrix, SameFieldOnOneAndTwoThreads) {
+  const std::vector<CuboidCell> cells = bars();
+  const int n = static_cast<int>(cells.size());
+  std::vector<Vec3> M(n), one, two;
+  for (int i = 0; i < n; ++i) M[i] = 1e6 * random_unit_vector(hash_key(13, i, 0, 0));
+  for (const bool single : {false, true}) {
+    CuboidDemag demag(cells, true, true);
+    HMatrixOptions options;
+    options.single_precision = single;
+    demag.compress(options);
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    demag.field(M, one);
+    omp_set_num_threads(2);
+    demag.field(M, two);
+    omp_set_num_threads(threads);
+    for (int i = 0; i < n; ++i)
+      for (int a = 0; a < 3; ++a) EXPECT_EQ(one[i][a], two[i][a]) << single << " " << i;
   }
 }
 

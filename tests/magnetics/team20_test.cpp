@@ -85,5 +85,27 @@ TEST(Team20, QuarterModelWithMirrorPlanes) {
   EXPECT_NEAR(-r.force_pole.z, m.force, 0.05 * m.force);
 }
 
+// The settings of the quarter model's fastest solve (docs/validation.md
+// "TEAM 20": the operator compressed in single precision, Newton to 1e-3)
+// against the dense operator in double precision solved to 1e-4: the same
+// force and Bz(P1) to 1e-4 at 3000 and 5000 AT, 5 mm cells.
+TEST(Team20, QuarterModelFastSettingsKeepTheForce) {
+  const team20::GradedProblem dense({5.0, 1.0, 5.0}, false, team20::GradedProblem::Storage::dense);
+  const team20::GradedProblem fast({5.0, 1.0, 5.0}, false, team20::GradedProblem::Storage::compressed_single);
+  BhSolveOptions tight, loose;
+  tight.tolerance = 1e-4;
+  loose.tolerance = 1e-3;
+  for (const int k : {1, 3}) {
+    const double ampere_turns = team20::kMeasured[k].ampere_turns;
+    std::vector<Vec3> Md(dense.demag.cells()), Mf(fast.demag.cells());
+    const team20::Result rd = team20::solve(dense, ampere_turns, Md, tight);
+    const team20::Result rf = team20::solve(fast, ampere_turns, Mf, loose);
+    ASSERT_TRUE(rd.report.converged);
+    ASSERT_TRUE(rf.report.converged);
+    EXPECT_NEAR(rf.force_pole.z, rd.force_pole.z, 1e-4 * std::abs(rd.force_pole.z)) << ampere_turns;
+    EXPECT_NEAR(rf.Bz_P1, rd.Bz_P1, 1e-4 * std::abs(rd.Bz_P1)) << ampere_turns;
+  }
+}
+
 }  // namespace
 }  // namespace odemag

@@ -321,9 +321,10 @@ struct GradedProblem {
   }
 
   // balance: also the forces on the yoke from the pole (the momentum check).
-  // compress: the operator as a hierarchical matrix (magnetics/hmatrix.h),
-  // else dense.
-  explicit GradedProblem(const Grading& g, bool with_balance = false, bool compress = true)
+  // The operator dense, or as a hierarchical matrix (magnetics/hmatrix.h)
+  // in double or single precision.
+  enum class Storage { dense, compressed, compressed_single };
+  explicit GradedProblem(const Grading& g, bool with_balance = false, Storage storage = Storage::compressed)
       : grading(g), balance(with_balance), demag(make(g, pole_cells), true, true) {
     std::vector<Vec3> centres(demag.cells());
     for (int i = 0; i < demag.cells(); ++i) centres[i] = demag.cell(i).centre;
@@ -331,7 +332,9 @@ struct GradedProblem {
     const int N = demag.cells();
     force_from_yoke = demag.force_operator(0, pole_cells, pole_cells, N);
     if (balance) force_on_yoke = demag.force_operator(pole_cells, N, 0, pole_cells);
-    if (compress) demag.compress();
+    HMatrixOptions options;
+    options.single_precision = storage == Storage::compressed_single;
+    if (storage != Storage::dense) demag.compress(options);
   }
   // All cells of the whole problem (the quarter's times four).
   int full_cells() const { return 4 * demag.cells(); }
