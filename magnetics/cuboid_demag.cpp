@@ -220,7 +220,6 @@ void CuboidDemag::compress(const HMatrixOptions& options) {
     boxes[i] = {cells_[i].centre, cells_[i].half};
     self_[i] = S_.block<3, 3>(3 * i, 3 * i) / volume(i);
   }
-  self_.resize(N);
   compressed_ = std::make_shared<const HMatrix>(
       boxes, images_, [this](int r, int c) { return r >= c ? S_(r, c) : S_(c, r); }, options);
   S_ = Eigen::MatrixXd();

@@ -37,7 +37,7 @@ HMatrix::HMatrix(const std::vector<CellBox>& cells, const std::vector<Vec3>& ima
     Eigen::MatrixXd a(3 * (r.end - r.begin), 3 * (c.end - c.begin));
     for (int i = 0; i < a.rows(); ++i)
       for (int j = 0; j < a.cols(); ++j)
-        a(i, j) = entry(3 * order_[r.begin + i / 3] + i % 3, 3 * order_[c.begin + j / 3] + j % 3);
+        a(i, j) = entry(scalar_index(r, i), scalar_index(c, j));
     double_.dense.push_back(std::move(a));
   }
   // The chunks of multiply: blocks (dense first, then low-rank) in runs of
@@ -149,8 +149,6 @@ bool HMatrix::cross_approximation(const Cluster& a, const Cluster& b, const std:
                                   Eigen::MatrixXd& u, Eigen::MatrixXd& v) const {
   const int m = 3 * (a.end - a.begin), n = 3 * (b.end - b.begin);
   const int max_rank = m * n / (m + n);  // past it the factors outweigh the block
-  auto row_index = [&](int i) { return 3 * order_[a.begin + i / 3] + i % 3; };
-  auto col_index = [&](int j) { return 3 * order_[b.begin + j / 3] + j % 3; };
   std::vector<Eigen::VectorXd> us, vs;
   std::vector<bool> row_used(m, false);
   double approximation2 = 0.0;  // |U V^T|_F^2
@@ -158,14 +156,14 @@ bool HMatrix::cross_approximation(const Cluster& a, const Cluster& b, const std:
   for (int attempts = 0; attempts < m && static_cast<int>(us.size()) < max_rank; ++attempts) {
     row_used[pivot_row] = true;
     Eigen::VectorXd row(n);
-    for (int j = 0; j < n; ++j) row(j) = entry(row_index(pivot_row), col_index(j));
+    for (int j = 0; j < n; ++j) row(j) = entry(scalar_index(a, pivot_row), scalar_index(b, j));
     for (size_t k = 0; k < us.size(); ++k) row -= us[k](pivot_row) * vs[k];
     Eigen::Index pivot_col;
     const double largest = row.cwiseAbs().maxCoeff(&pivot_col);
     if (largest > 0.0) {
       const Eigen::VectorXd vk = row / row(pivot_col);
       Eigen::VectorXd uk(m);
-      for (int i = 0; i < m; ++i) uk(i) = entry(row_index(i), col_index(static_cast<int>(pivot_col)));
+      for (int i = 0; i < m; ++i) uk(i) = entry(scalar_index(a, i), scalar_index(b, static_cast<int>(pivot_col)));
       for (size_t k = 0; k < us.size(); ++k) uk -= vs[k](pivot_col) * us[k];
       // |S_k|^2 = |S_{k-1}|^2 + 2 sum_l (u_l . u)(v_l . v) + |u|^2 |v|^2
       double cross = 0.0;

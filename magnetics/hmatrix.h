@@ -1,8 +1,9 @@
 // A symmetric matrix of cell-to-cell 3x3 blocks stored as a hierarchical
-// matrix (docs/model.md "Compressed operator"): the cells ordered by a
-// cluster tree (boxes bisected along their longest axis), a block between
-// two clusters far apart against their size stored as a product U V^T of
-// low rank found by adaptive cross approximation, the rest dense.
+// matrix (docs/model.md "The compressed operator and stored forces"): the
+// cells ordered by a cluster tree (boxes bisected along their longest axis),
+// a block between two clusters far apart against their size stored as a
+// product U V^T of low rank found by adaptive cross approximation, the rest
+// dense.
 //
 // Two clusters A and B are far apart when
 //   max(diam A, diam B) <= eta dist(A, P_s B)   for every image s          (1)
@@ -32,7 +33,7 @@ struct HMatrixOptions {
   double eta = 1.0;         // (1)
   int leaf_cells = 8;       // clusters of at most this many cells are not split
   // Store the blocks in single precision (docs/model.md "The compressed
-  // operator and stored forces": a matvec about 1.4 times faster, but GMRES
+  // operator and stored forces": a matvec about 1.6 times faster, but GMRES
   // then stalls near 1e-6 relative, so only for solves to 1e-3 or looser).
   bool single_precision = false;
 };
@@ -77,6 +78,8 @@ class HMatrix {
 
   int split(int begin, int end, const std::vector<CellBox>& cells);
   bool far_apart(const Cluster& a, const Cluster& b) const;
+  // The matrix's scalar index (3 cell + component) of a cluster's local row k.
+  int scalar_index(const Cluster& c, int k) const { return 3 * order_[c.begin + k / 3] + k % 3; }
   void partition(int a, int b, const std::function<double(int, int)>& entry);
   bool cross_approximation(const Cluster& a, const Cluster& b, const std::function<double(int, int)>& entry,
                            Eigen::MatrixXd& u, Eigen::MatrixXd& v) const;
