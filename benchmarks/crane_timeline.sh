@@ -3,9 +3,11 @@
 # the other on the same machine (docs/benchmarks.md section 4):
 #
 #   benchmarks/crane_timeline.sh --before PATH [--after PATH] [--duration T] [--out DIR]
+#                                [--before-scene FILE] [--after-scene FILE]
 #
 # PATH: a crane_timeline program (benchmarks/crane_timeline.cpp); --after
-# defaults to build-bench/bin/crane_timeline (built when missing). Writes
+# defaults to build-bench/bin/crane_timeline (built when missing). The scenes
+# default to each program's own demos/scenes/crane.json. Writes
 # DIR/crane_timeline.csv (rows labelled "before" and "after"),
 # DIR/crane_phases.md (each run's phase table) and DIR/crane_timeline.png
 # (gnuplot). DIR defaults to benchmarks/results. Each full run takes 5-12 min
@@ -17,13 +19,17 @@ before=""
 after=""
 duration=""
 out="$root/benchmarks/results"
-usage() { sed -n '2,12p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
+before_scene=""
+after_scene=""
+usage() { sed -n '2,14p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --before) before=$2; shift 2 ;;
     --after) after=$2; shift 2 ;;
     --duration) duration=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
+    --before-scene) before_scene=$2; shift 2 ;;
+    --after-scene) after_scene=$2; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "crane_timeline.sh: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
   esac
@@ -46,18 +52,22 @@ trap 'rm -rf "$work"' EXIT
 mkdir -p "$out"
 args=(--threads 2)
 [ -z "$duration" ] || args+=(--duration "$duration")
-"$before" "${args[@]}" --label before --csv "$work/before.csv" > "$work/before.md"
-"$after" "${args[@]}" --label after --csv "$work/after.csv" > "$work/after.md"
+before_args=("${args[@]}")
+after_args=("${args[@]}")
+[ -z "$before_scene" ] || before_args+=(--scene "$before_scene")
+[ -z "$after_scene" ] || after_args+=(--scene "$after_scene")
+"$before" "${before_args[@]}" --label before --csv "$work/before.csv" > "$work/before.md"
+"$after" "${after_args[@]}" --label after --csv "$work/after.csv" > "$work/after.md"
 { cat "$work/before.csv"; tail -n +2 "$work/after.csv"; } > "$out/crane_timeline.csv"
 model=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')
 {
   echo "Machine: $model, $(nproc) logical CPUs, 2 OpenMP threads (OMP_WAIT_POLICY=passive). Per rigid step (1 ms), means over each phase of the crane's time line; times in ms; dense evaluation: one responsive-field evaluation of the same cells (MagneticBackend::responsive_field) measured in the same run every 50 steps; T_m / evaluation: T_m in units of it."
   echo
-  echo "Before ($before):"
+  echo "Before ($before${before_scene:+, $before_scene}):"
   echo
   cat "$work/before.md"
   echo
-  echo "After ($after):"
+  echo "After ($after${after_scene:+, $after_scene}):"
   echo
   cat "$work/after.md"
 } > "$out/crane_phases.md"

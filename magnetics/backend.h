@@ -41,6 +41,18 @@ class MagneticBackend {
   // of the paper's model; mutual_induction as RelaxOptions::mutual_induction.
   virtual void set_near_field(bool on, bool mutual_induction) = 0;
 
+  // Bodies whose magnetization the next relaxations keep (RelaxOptions::
+  // held_bodies; by body, 1: held; empty: none), taking effect at once;
+  // relax and magnetic_step set it and reset it to none when they end. A
+  // backend that returns true neither relaxes their cells nor needs their
+  // rows of the responsive field; the default relaxes every cell, a held one
+  // under its last applied field (the relaxation passes that), which keeps it
+  // where it was up to the body's turn.
+  virtual bool set_held_bodies(const std::vector<uint8_t>& held) {
+    (void)held;
+    return false;
+  }
+
   // H_E plus the field of every fixed permanent cell, at each active
   // responsive cell. Constant during a relaxation.
   virtual void fixed_field(const MagneticModel& model, const MagneticState& state,

@@ -519,6 +519,7 @@ class BallLatticeNearField final : public NearFieldTerm {
                  std::vector<Vec3>& H) const override {
     const bool responsive_sources = sources == NearFieldSources::responsive;
     for (const PairCoupling& p : couplings_) {
+      if (both_held(p.b, p.c)) continue;
       if (p.responsive_b && p.responsive_c == responsive_sources)
         H[p.b] += symmetric_times(p.K, p.volume_c * state.magnetization[p.c]);
       if (p.responsive_c && p.responsive_b == responsive_sources)

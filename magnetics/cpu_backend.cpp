@@ -73,9 +73,21 @@ class CpuBackend final : public MagneticBackend {
       tree_.build(resp_.x.data(), resp_.y.data(), resp_.z.data(), resp_.radius.data(),
                   layout_.responsive.body.data(), resp_.size(), far_field_theta_);
     near_.build(model, state, near_field_, near_mutual_induction_);
+    held_cell_.clear();
+    if (!held_.empty()) {
+      held_cell_.assign(model.cell_count(), 0);
+      for (int b = 0; b < model.body_count(); ++b)
+        if (held_[b])
+          std::fill_n(held_cell_.begin() + model.body(b).first_cell, model.body(b).cell_count(), 1);
+    }
+    near_.set_held_cells(&held_cell_);
   }
 
   void set_far_field(double theta) override { far_field_theta_ = theta; }
+  bool set_held_bodies(const std::vector<uint8_t>& held) override {
+    held_ = held;
+    return true;
+  }
   void set_near_field(bool on, bool mutual_induction) override {
     near_field_ = on;
     near_mutual_induction_ = mutual_induction;
@@ -109,6 +121,10 @@ class CpuBackend final : public MagneticBackend {
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads_) if (static_cast<long>(n) * n > kParallelPairs)
     for (int i = 0; i < n; ++i) {
       const auto [b, begin, end] = resp.run_of(i);
+      if (is_held(b)) {  // not relaxed: its field is not needed
+        H[resp.cell[i]] = {};
+        continue;
+      }
       // Inter-body: every responsive cell of another body.
       Vec3 h = use_tree_ ? tree_field_[i]
                          : sum_field(resp_.sources(), 0, begin, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]) +
@@ -150,6 +166,7 @@ class CpuBackend final : public MagneticBackend {
     reduction(max : worst) if (n > 16)
     for (int i = 0; i < n; ++i) {
       const int c = layout_.responsive.cell[i], b = layout_.responsive.body[i];
+      if (is_held(b)) continue;  // keeps its moments (place_cells turned them with the body)
       const MagneticBody& body = model.body(b);
       const Mat3& R = state.pose[b].rotation;
       if (body.kind == CellKind::recoil_permanent) {
@@ -234,6 +251,9 @@ class CpuBackend final : public MagneticBackend {
   bool near_field_ = true, near_mutual_induction_ = true;
   NearField near_;
   double far_field_theta_ = 0.0;  // 0: every pair summed exactly
+  std::vector<uint8_t> held_;      // by body: magnetization kept (set_held_bodies); empty: none
+  std::vector<uint8_t> held_cell_;  // the same by cell, for the near field
+  bool is_held(int b) const { return !held_.empty() && held_[b]; }
   bool use_tree_ = false;
   FarFieldTree tree_;
   std::vector<Vec3> tree_field_;

@@ -353,6 +353,7 @@ class LatticeNearField final : public NearFieldTerm {
   void add_field(const MagneticModel& model, const MagneticState& state, NearFieldSources sources,
                  std::vector<Vec3>& H) const override {
     for (const CellPair& p : pairs_) {
+      if (both_held(p.i, p.j)) continue;
       const BodyLink& l = links_[p.link];
       const bool resp_a = model.body(l.a).responsive(), resp_b = model.body(l.b).responsive();
       // Targets: responsive cells; sources: as the dense sums split them.

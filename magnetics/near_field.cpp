@@ -18,6 +18,10 @@ void NearField::build(const MagneticModel& model, const MagneticState& state, bo
   }
 }
 
+void NearField::set_held_cells(const std::vector<uint8_t>* held) {
+  for (const auto& t : terms_) t->set_held_cells(held);
+}
+
 void NearField::add_field(const MagneticModel& model, const MagneticState& state, NearFieldSources sources,
                           std::vector<Vec3>& H) const {
   if (!enabled_) return;

@@ -65,8 +65,17 @@ class NearFieldTerm {
   // neighbour) is then left out. Takes effect at the next build.
   void set_mutual_induction(bool on) { mutual_induction_ = on; }
 
+  // By cell, 1 where the relaxation keeps the magnetization (RelaxOptions::
+  // held_bodies); nullptr or empty: none. add_field skips the pairs of two
+  // held cells, whose fields nothing reads.
+  void set_held_cells(const std::vector<uint8_t>* held) { held_cells_ = held; }
+
  protected:
+  bool both_held(int a, int b) const {
+    return held_cells_ && !held_cells_->empty() && (*held_cells_)[a] && (*held_cells_)[b];
+  }
   bool mutual_induction_ = true;
+  const std::vector<uint8_t>* held_cells_ = nullptr;
 };
 
 std::unique_ptr<NearFieldTerm> make_sphere_near_field();
@@ -80,6 +89,8 @@ class NearField {
   // enabled = false: no pairs (the paper's point-dipole model);
   // mutual_induction: NearFieldTerm::set_mutual_induction.
   void build(const MagneticModel& model, const MagneticState& state, bool enabled, bool mutual_induction = true);
+  // NearFieldTerm::set_held_cells for every term; the vector must outlive its use.
+  void set_held_cells(const std::vector<uint8_t>* held);
   void add_field(const MagneticModel& model, const MagneticState& state, NearFieldSources sources,
                  std::vector<Vec3>& H) const;
   void add_forces(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& force,

@@ -192,6 +192,23 @@ RelaxReport relax_one_pass(const MagneticModel& model, MagneticState& state, con
   return report;
 }
 
+// The cells a relaxation solves for: every active responsive cell but those
+// of held bodies (RelaxOptions::held_bodies); and those held.
+bool held(const RelaxOptions& o, int b) { return !o.held_bodies.empty() && o.held_bodies[b]; }
+
+std::vector<int> solved_cells(const MagneticModel& model, const MagneticState& state, const RelaxOptions& o) {
+  std::vector<int> cells = active_responsive_cells(model, state);
+  if (o.held_bodies.empty()) return cells;
+  std::erase_if(cells, [&](int c) { return held(o, model.cell_body(c)); });
+  return cells;
+}
+
+std::vector<int> held_cells(const MagneticModel& model, const MagneticState& state, const RelaxOptions& o) {
+  std::vector<int> cells = active_responsive_cells(model, state);
+  std::erase_if(cells, [&](int c) { return !held(o, model.cell_body(c)); });
+  return cells;
+}
+
 // The outer loop of the two-level scheme. x: applied field at the responsive
 // cells, flattened; G(x): the applied field after relaxing every cell under x.
 struct OuterLoop {
@@ -201,6 +218,7 @@ struct OuterLoop {
   const RelaxOptions& o;
   const std::vector<int>& cells;
   const std::vector<Vec3>& H_fixed;
+  std::vector<int> held_cells;  // active responsive cells of held bodies (RelaxOptions::held_bodies)
   LocalRelaxOptions local;
   std::vector<Vec3> H_A, H_resp;  // by cell: the field x relaxed under; the responsive field after
   double local_residual = 0.0;    // the last relax_cells' largest residual (NaN: non-finite cells)
@@ -272,8 +290,13 @@ void remember_relaxation_change(const OuterLoop& l, const std::vector<Vec3>& h, 
   std::vector<Vec3> last(s.relaxation_change.size());
   if (converged)
     for (size_t i = 0; i < h.size(); ++i) last[l.cells[i]] = l.H_A[l.cells[i]] - h[i];
-  s.previous_relaxation_change =
-      converged ? std::move(s.relaxation_change) : std::vector<Vec3>(last.size());
+  std::vector<Vec3> before = converged ? std::move(s.relaxation_change) : std::vector<Vec3>(last.size());
+  // Held cells were not relaxed: they keep what their last relaxations found.
+  for (int c : l.held_cells) {
+    last[c] = converged ? before[c] : s.relaxation_change[c];
+    before[c] = s.previous_relaxation_change[c];
+  }
+  s.previous_relaxation_change = std::move(before);
   s.relaxation_change = std::move(last);
 }
 
@@ -456,8 +479,10 @@ RelaxReport relax_two_level(const MagneticModel& model, MagneticState& state, co
                             MagneticBackend& backend, const std::vector<int>& cells,
                             const std::vector<Vec3>& H_fixed) {
   RelaxReport report;
-  OuterLoop l{model, state, backend, o, cells, H_fixed, o.local,
-              std::vector<Vec3>(model.cell_count()), std::vector<Vec3>(model.cell_count())};
+  // A held cell's applied field stays its last (a backend that relaxes every
+  // cell relaxes it under that: MagneticBackend::set_held_bodies).
+  OuterLoop l{model, state, backend, o, cells, H_fixed, held_cells(model, state, o), o.local,
+              state.applied_field, std::vector<Vec3>(model.cell_count())};
   l.local.single_step = false;
   const std::vector<Vec3> h = initial_iterate(l, report);
   std::vector<double> x = flatten(predicted_start(l, h)), f(x.size());
@@ -510,6 +535,7 @@ void place_cells_and_begin_step(const MagneticModel& model, MagneticState& state
   place_cells(model, state);
   backend.set_far_field(o.far_field_theta);
   backend.set_near_field(o.near_field, o.mutual_induction);
+  backend.set_held_bodies(o.held_bodies);
   backend.begin_step(model, state);
 }
 
@@ -550,8 +576,10 @@ void compute_forces(const MagneticModel& model, MagneticState& state, MagneticBa
 
 // docs/architecture.md "One magnetic step", 5: remember what was solved, for the skip check.
 void record_step(MagneticState& state, const RelaxOptions& o, const RelaxReport& report) {
-  // Only a run that skips pays for remembering what it solved.
-  if (o.skip_unchanged) {
+  // Only a run that skips pays for remembering what it solved; a relaxation
+  // that held bodies did not solve for theirs.
+  const bool held_any = std::find(o.held_bodies.begin(), o.held_bodies.end(), 1) != o.held_bodies.end();
+  if (o.skip_unchanged && !held_any) {
     record_solve(state, o, report.converged);
   } else {
     state.last_solve.valid = false;
@@ -563,20 +591,23 @@ void record_step(MagneticState& state, const RelaxOptions& o, const RelaxReport&
 RelaxReport relax(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
                   MagneticBackend& backend) {
   place_cells_and_begin_step(model, state, o, backend);
-  const std::vector<int> cells = active_responsive_cells(model, state);
+  const std::vector<int> cells = solved_cells(model, state, o);
   const std::vector<Vec3> H_fixed = fixed_field(model, state, backend, cells);
-  return solve(model, state, o, backend, cells, H_fixed);
+  RelaxReport report = solve(model, state, o, backend, cells, H_fixed);
+  if (!o.held_bodies.empty()) backend.set_held_bodies({});  // held for this relaxation only
+  return report;
 }
 
 RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
                           const RelaxOptions& options, MagneticBackend& backend) {
   if (can_skip_step(model, state, options)) return skipped_report();
   place_cells_and_begin_step(model, state, options, backend);
-  const std::vector<int> cells = active_responsive_cells(model, state);
+  const std::vector<int> cells = solved_cells(model, state, options);
   const std::vector<Vec3> H_fixed = fixed_field(model, state, backend, cells);
   RelaxReport report = solve(model, state, options, backend, cells, H_fixed);
   compute_forces(model, state, backend);
   record_step(state, options, report);
+  if (!options.held_bodies.empty()) backend.set_held_bodies({});  // held for this step only
   return report;
 }
 

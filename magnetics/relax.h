@@ -64,6 +64,13 @@ struct RelaxOptions {
   // (MagneticState::relaxation_change, docs/model.md "Predicted warm
   // start"). false: from the warm start's field, as before.
   bool predict_warm_start = true;
+  // Bodies whose magnetization is kept, turned with the body but not solved
+  // for (by body index, 1: held; empty: none): their cells act as sources
+  // and feel forces, and the relaxation converges on the others' cells.
+  // The scene simulation's magnetic_solve "moving" holds, in a rigid step's
+  // later substeps, every body that neither needs the substeps nor touches
+  // one that does (docs/simulation.md "Substeps").
+  std::vector<uint8_t> held_bodies;
   LocalRelaxOptions local;
   // Called after every outer iteration with the report so far (iterations,
   // residual_history): progress lines of a long `odemag solve`. Empty: none.

@@ -494,6 +494,7 @@ class SphereNearField final : public NearFieldTerm {
     const bool responsive_sources = sources == NearFieldSources::responsive;
     for (const SpherePair& p : pairs_) {
       const SphereCell &ca = cells_[p.sa], &cb = cells_[p.sb];
+      if (both_held(ca.cell, cb.cell)) continue;
       const double sigma = saturation_factor(m, p);
       const Vec3 za = ca.responsive == responsive_sources ? m.dipole[p.sa] : Vec3{};
       const Vec3 zb = cb.responsive == responsive_sources ? m.dipole[p.sb] : Vec3{};

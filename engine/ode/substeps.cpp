@@ -25,56 +25,71 @@ SubstepBody substep_body(const MagneticBody& body, const dMass& mass) {
   return s;
 }
 
+double SubstepRule::longest_substep(int b, double shortest, const SubstepMotion& s, double gravity,
+                                    double external_field, const std::function<double(int)>& clearance) const {
+  if (!s.free) return shortest;
+  const double f = norm(s.force), m = s.mass, size = bodies_[b].size;
+  const double reach = bodies_[b].reach, inertia = bodies_[b].inertia;
+  // Rotational stiffness: |tau| for the torque of the other bodies (it
+  // turns a body about an orientation of equilibrium), and mu0 |m| |H_E|
+  // for the uniform field, whose torque vanishes at equilibrium while its
+  // stiffness does not (docs/hard-cases.md "Substeps").
+  double k_rot = norm(s.torque);
+  if (bodies_[b].turns_in_field) k_rot += kMu0 * norm(s.moment) * external_field;
+  // Collision: the travel v h + a h^2 / 2 in one substep of the body's
+  // farthest point, at the current velocity (translation plus rotation
+  // times the bounding radius) and the full acceleration (gravity, magnetic
+  // force, and the angular acceleration times the bounding radius), at most
+  // L: a tenth of the body's size, three tenths for a body that was in
+  // contact (which most likely still holds it; it may have lifted off by a
+  // hair, so its acceleration still counts). Solved for h. The contact
+  // allowance is for what the contact holds back (the acceleration): the
+  // velocity's own travel v h stays within a tenth of the size, or a body
+  // that moves fast while touching another (two lattice magnets started at
+  // one centre spin apart) meets the floor up to 0.3 of its size deep
+  // (docs/hard-cases.md "Substeps").
+  const double v = norm(s.velocity) + norm(s.angular_velocity) * reach;
+  const double a = f / m + gravity + (inertia > 0.0 ? norm(s.torque) / inertia * reach : 0.0);
+  double L = (s.in_contact ? kContactTravel : kFreeTravel) * size;
+  auto travel_time = [&] { return 2.0 * L / (v + std::sqrt(v * v + 2.0 * a * L)); };
+  // In free flight, half the clearance as well: nothing is nearer, and a
+  // body that comes the other way covers at most the other half (a ball
+  // falling from the crane needs no substeps until it nears the heap).
+  // Not while the magnetic force exceeds the body's weight: it grows
+  // steeply as the body nears a magnet, which the constant acceleration of
+  // the bound does not see (a ball dropped onto a magnet sank 0.34 of its
+  // size into it with the clearance counted at any force).
+  if (!s.in_contact && clearance && f <= m * gravity && travel_time() < shortest) L += 0.5 * clearance(b);
+  shortest = std::min(shortest, travel_time());
+  if (s.in_contact && v > 0.0) shortest = std::min(shortest, kFreeTravel * size / v);
+  // Time scale of the magnetic force: it varies over distances of the
+  // body's size, so it oscillates a body about an equilibrium at
+  // omega^2 ~ |F| / (m size); and the torque about an orientation at
+  // omega^2 ~ k_rot / I. The explicit update needs omega h <= limit.
+  if (f > 0.0) shortest = std::min(shortest, settings_.stiffness_limit / std::sqrt(f / (m * size)));
+  if (k_rot > 0.0 && inertia > 0.0)
+    shortest = std::min(shortest, settings_.stiffness_limit / std::sqrt(k_rot / inertia));
+  return shortest;
+}
+
+namespace {
+int substeps_for(double dt, double longest) {
+  const double k = std::ceil(dt / longest * (1.0 - 1e-12));
+  return std::isfinite(k) ? std::max(1, static_cast<int>(std::min(k, 1e9))) : 1000000000;
+}
+}  // namespace
+
 int SubstepRule::needed(double dt, const std::vector<SubstepMotion>& motion, double gravity, double external_field,
                         const std::function<double(int)>& clearance) const {
   double shortest = dt;  // longest admissible substep
-  for (int b = 0; b < body_count(); ++b) {
-    const SubstepMotion& s = motion[b];
-    if (!s.free) continue;
-    const double f = norm(s.force), m = s.mass, size = bodies_[b].size;
-    const double reach = bodies_[b].reach, inertia = bodies_[b].inertia;
-    // Rotational stiffness: |tau| for the torque of the other bodies (it
-    // turns a body about an orientation of equilibrium), and mu0 |m| |H_E|
-    // for the uniform field, whose torque vanishes at equilibrium while its
-    // stiffness does not (docs/hard-cases.md "Substeps").
-    double k_rot = norm(s.torque);
-    if (bodies_[b].turns_in_field) k_rot += kMu0 * norm(s.moment) * external_field;
-    // Collision: the travel v h + a h^2 / 2 in one substep of the body's
-    // farthest point, at the current velocity (translation plus rotation
-    // times the bounding radius) and the full acceleration (gravity, magnetic
-    // force, and the angular acceleration times the bounding radius), at most
-    // L: a tenth of the body's size, three tenths for a body that was in
-    // contact (which most likely still holds it; it may have lifted off by a
-    // hair, so its acceleration still counts). Solved for h. The contact
-    // allowance is for what the contact holds back (the acceleration): the
-    // velocity's own travel v h stays within a tenth of the size, or a body
-    // that moves fast while touching another (two lattice magnets started at
-    // one centre spin apart) meets the floor up to 0.3 of its size deep
-    // (docs/hard-cases.md "Substeps").
-    const double v = norm(s.velocity) + norm(s.angular_velocity) * reach;
-    const double a = f / m + gravity + (inertia > 0.0 ? norm(s.torque) / inertia * reach : 0.0);
-    double L = (s.in_contact ? kContactTravel : kFreeTravel) * size;
-    auto travel_time = [&] { return 2.0 * L / (v + std::sqrt(v * v + 2.0 * a * L)); };
-    // In free flight, half the clearance as well: nothing is nearer, and a
-    // body that comes the other way covers at most the other half (a ball
-    // falling from the crane needs no substeps until it nears the heap).
-    // Not while the magnetic force exceeds the body's weight: it grows
-    // steeply as the body nears a magnet, which the constant acceleration of
-    // the bound does not see (a ball dropped onto a magnet sank 0.34 of its
-    // size into it with the clearance counted at any force).
-    if (!s.in_contact && clearance && f <= m * gravity && travel_time() < shortest) L += 0.5 * clearance(b);
-    shortest = std::min(shortest, travel_time());
-    if (s.in_contact && v > 0.0) shortest = std::min(shortest, kFreeTravel * size / v);
-    // Time scale of the magnetic force: it varies over distances of the
-    // body's size, so it oscillates a body about an equilibrium at
-    // omega^2 ~ |F| / (m size); and the torque about an orientation at
-    // omega^2 ~ k_rot / I. The explicit update needs omega h <= limit.
-    if (f > 0.0) shortest = std::min(shortest, settings_.stiffness_limit / std::sqrt(f / (m * size)));
-    if (k_rot > 0.0 && inertia > 0.0)
-      shortest = std::min(shortest, settings_.stiffness_limit / std::sqrt(k_rot / inertia));
-  }
-  const double k = std::ceil(dt / shortest * (1.0 - 1e-12));
-  return std::isfinite(k) ? std::max(1, static_cast<int>(std::min(k, 1e9))) : 1000000000;
+  for (int b = 0; b < body_count(); ++b)
+    shortest = longest_substep(b, shortest, motion[b], gravity, external_field, clearance);
+  return substeps_for(dt, shortest);
+}
+
+int SubstepRule::needed_by(int b, double dt, const SubstepMotion& motion, double gravity, double external_field,
+                           const std::function<double(int)>& clearance) const {
+  return substeps_for(dt, longest_substep(b, dt, motion, gravity, external_field, clearance));
 }
 
 int SubstepRule::update(int wanted, double time, double dt, bool step_start) {

@@ -68,6 +68,9 @@ class SubstepRule {
   // shorten the substep; it may then cover half of it as well.
   int needed(double dt, const std::vector<SubstepMotion>& motion, double gravity, double external_field,
              const std::function<double(int)>& clearance = {}) const;
+  // What body b alone needs (needed() is the largest over the bodies).
+  int needed_by(int b, double dt, const SubstepMotion& motion, double gravity, double external_field,
+                const std::function<double(int)>& clearance = {}) const;
 
   // The count in use after the rule wanted `wanted` (needed()) at `time`,
   // s: raised at once, lowered only at a step's start (step_start) after a
@@ -77,6 +80,10 @@ class SubstepRule {
   int count() const { return count_; }
 
  private:
+  // The longest admissible substep of body b, at most `shortest` (s): the
+  // clearance is asked for only when b's travel bound would shorten it.
+  double longest_substep(int b, double shortest, const SubstepMotion& motion, double gravity,
+                         double external_field, const std::function<double(int)>& clearance) const;
   SubstepSettings settings_;
   std::vector<SubstepBody> bodies_;
   // Count in use, and the largest count needed since it was last set (at

@@ -1001,7 +1001,7 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
     {.name = "stiffness_limit", .check = Check::positive, .slot = SLOT(stiffness_limit),
      .doc = {"number", "", "`1`"}},
     {.name = "magnetic_solve", .check = Check::choice, .slot = SLOT(magnetic_solve),
-     .words = {"substep", "step"}, .doc = {"string", "", "`\"substep\"`"}},
+     .words = {"substep", "step", "moving"}, .doc = {"string", "", "`\"substep\"`"}},
 };
 
 const KeyTable<CameraSettings> kCameraKeys = {

@@ -212,6 +212,7 @@ void RigidWorld::integrate(double h) {
   for (ForceAccumulator* a : accumulators_) a->add_forces();
   for (Body& b : bodies_) b.in_contact = false, b.contacts = 0, b.touches_kinematic = false;
   touching_.clear();
+  touching_kinematic_.clear();
   if (sleep_.time > 0.0) wake_on_force_change();
   // ODE's random numbers (dWorldQuickStep reorders constraints randomly) come
   // from one seed per process: each world keeps its own sequence, so a run
@@ -286,6 +287,7 @@ void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
     self->touching_.emplace_back(self->index_of(ba), self->index_of(bb));
   } else if (ba && bb) {  // one of them kinematic: it may move, so the other is awake
     const int moving = self->index_of(a_moves ? ba : bb);
+    self->touching_kinematic_.emplace_back(moving, self->index_of(a_moves ? bb : ba));
     self->bodies_[moving].touches_kinematic = true;
     if (self->bodies_[moving].sleeping) self->wake(moving);
   }

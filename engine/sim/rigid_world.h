@@ -61,6 +61,10 @@ class RigidWorld {
   // touches it, it touches nothing, or the time line acts.
   bool sleeping(int i) const { return bodies_[i].sleeping; }
   int sleeping_count() const;
+  // Pairs of dynamic bodies that touched in the last integrate(); and pairs
+  // (dynamic, kinematic) that did.
+  const std::vector<std::pair<int, int>>& touching() const { return touching_; }
+  const std::vector<std::pair<int, int>>& touching_kinematic() const { return touching_kinematic_; }
 
   // Whether the body touched something in the last integrate().
   bool in_contact(int i) const { return bodies_[i].in_contact; }
@@ -129,6 +133,7 @@ class RigidWorld {
   double gravity_ = 0.0;  // |g|, m/s^2
   // Pairs of dynamic bodies in contact in the last integrate().
   std::vector<std::pair<int, int>> touching_;
+  std::vector<std::pair<int, int>> touching_kinematic_;  // (dynamic, kinematic)
   struct FoundContact {
     dContact contact;
     dBodyID a, b;  // nullptr: the ground

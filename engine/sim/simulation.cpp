@@ -135,7 +135,7 @@ void Simulation::apply_timeline(double dt) {
   }
 }
 
-int Simulation::substeps_needed(double dt) {
+void Simulation::update_substep_motion() {
   for (int b = 0; b < world_->body_count(); ++b) {
     SubstepMotion& m = substep_motion_[b];
     // A sleeping body does not move (docs/simulation.md "Sleeping bodies").
@@ -149,8 +149,31 @@ int Simulation::substeps_needed(double dt) {
     if (substep_rule_.body(b).turns_in_field) m.moment = magnetics_->moment(b);
     m.in_contact = world_->in_contact(b);
   }
+}
+
+int Simulation::substeps_needed(double dt) {
+  update_substep_motion();
   return substep_rule_.needed(dt, substep_motion_, norm(scene_.gravity), norm(magnetics_->external_field()),
                               [this](int b) { return world_->clearance(b); });
+}
+
+std::vector<uint8_t> Simulation::bodies_to_hold(double dt) {
+  update_substep_motion();
+  const int n = world_->body_count();
+  std::vector<uint8_t> moving(n, 0);
+  for (int b = 0; b < n; ++b)
+    moving[b] = substep_motion_[b].free &&
+                substep_rule_.needed_by(b, dt, substep_motion_[b], norm(scene_.gravity),
+                                        norm(magnetics_->external_field()),
+                                        [this](int i) { return world_->clearance(i); }) > 1;
+  std::vector<uint8_t> held(n, 1);
+  for (int b = 0; b < n; ++b)
+    if (moving[b]) held[b] = 0;
+  for (const auto& [a, b] : world_->touching())
+    if (moving[a] || moving[b]) held[a] = held[b] = 0;
+  for (const auto& [a, k] : world_->touching_kinematic())
+    if (moving[a]) held[k] = 0;
+  return held;
 }
 
 void Simulation::update_substeps(double dt, bool step_start, StepRecord& record) {
@@ -166,7 +189,8 @@ void Simulation::step() {
   apply_timeline(dt);
   StepRecord record;
   record.time = time_;
-  const bool relax_every_substep = scene_.simulation.magnetic_solve == "substep";
+  const bool relax_every_substep = scene_.simulation.magnetic_solve != "step";
+  const bool hold_slow_bodies = scene_.simulation.magnetic_solve == "moving";
   auto update_forces = [&](double t, double h, bool relax) {
     // T_m: relaxation, forces and torques; or, with magnetic_solve "step"
     // after the first substep, the forces at the held magnetization.
@@ -209,7 +233,13 @@ void Simulation::step() {
     // A NaN stops the step: ODE's collision would abort on it.
     note_non_finite(time_ + done);
     if (dt - done <= 1e-9 * dt || non_finite_body_ >= 0) break;
+    if (hold_slow_bodies) {
+      std::vector<uint8_t>& held = magnetics_->options().held_bodies = bodies_to_hold(dt);
+      for (size_t b = 0; b < held.size(); ++b)
+        record.held += held[b] && magnetics_->model().body(static_cast<int>(b)).responsive();
+    }
     update_forces(time_ + done, dt / substeps_, relax_every_substep);
+    magnetics_->options().held_bodies.clear();
     update_substeps(dt, false, record);
   }
   record.sleeping = world_->sleeping_count();

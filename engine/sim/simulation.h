@@ -31,6 +31,7 @@ struct StepRecord {
   long newton_steps = 0;     // per-cell Newton steps of those relaxations, summed over cells
   int relaxations = 0;       // substeps that relaxed the magnetization (SimulationSettings::magnetic_solve)
   int skipped = 0;           // substeps whose magnetic step was skipped (solver.skip_unchanged)
+  int held = 0;              // magnetic_solve "moving": induced bodies held, summed over the later substeps
   bool converged = true;
   double residual = 0.0;
   int sleeping = 0;          // bodies asleep at the step's end (SleepSettings)
@@ -79,7 +80,12 @@ class Simulation {
   void apply_timeline(double dt);
   // Substeps the rule (engine/ode/substeps.h) wants now, before the cap
   // SimulationSettings::max_substeps.
+  void update_substep_motion();  // substep_motion_ from the world and the magnetics
   int substeps_needed(double dt);
+  // magnetic_solve "moving": by body, 1 for every body whose magnetization a
+  // later substep holds: all but the free bodies that alone need more than
+  // one substep of dt and the free bodies touching them.
+  std::vector<uint8_t> bodies_to_hold(double dt);
   // Sets substeps_ from substeps_needed through the rule (capped: raised at
   // once, lowered only at a step's start after a hold time); notes the
   // uncapped need in record.substeps_wanted.

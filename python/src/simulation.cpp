@@ -176,6 +176,7 @@ class PySimulation {
     d["converged"] = copied_array<bool>(column(&StepRecord::converged));
     d["residual"] = double_array(column(&StepRecord::residual));
     d["sleeping"] = copied_array<int>(column(&StepRecord::sleeping));
+    d["held"] = copied_array<int>(column(&StepRecord::held));
     return d;
   }
 

@@ -257,6 +257,26 @@ TEST(SubstepRule, FreeFlightMayCoverHalfItsClearance) {
   EXPECT_EQ(asked, 4);
 }
 
+// What each body needs alone (needed_by, which magnetic_solve "moving" asks):
+// the count needed() gives is the largest of them.
+TEST(SubstepRule, EachBodysNeedAndTheLargest) {
+  SubstepRule rule;
+  std::vector<SubstepMotion> motion;
+  one_free_ball(rule, motion);
+  rule.add_body({0.005, 0.0, 1e-9, false});
+  motion.push_back(motion[0]);
+  motion[1].velocity = {5.0, 0, 0};  // ten substeps of 0.5 mm
+  EXPECT_EQ(rule.needed_by(0, 0.001, motion[0], 0.0, 0.0), 1);
+  EXPECT_EQ(rule.needed_by(1, 0.001, motion[1], 0.0, 0.0), 10);
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 10);
+  motion[0].velocity = {0, 0, 2.0};
+  EXPECT_EQ(rule.needed_by(0, 0.001, motion[0], 0.0, 0.0), 4);
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 10);
+  motion[1].free = false;  // not counted
+  EXPECT_EQ(rule.needed_by(1, 0.001, motion[1], 0.0, 0.0), 1);
+  EXPECT_EQ(rule.needed(0.001, motion, 0.0, 0.0), 4);
+}
+
 TEST(MagneticStepper, BadArgumentsThrow) {
   EmbedWorld w(0.0);
   EXPECT_THROW(MagneticStepper(w.magnetics, nullptr, w.space, &EmbedWorld::near_callback, &w, w.contacts),
