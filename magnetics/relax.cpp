@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "magnetics/anderson.h"
@@ -532,6 +534,9 @@ RelaxReport skipped_report() {
 // docs/architecture.md "One magnetic step", 1: place the cells, begin the backend's step.
 void place_cells_and_begin_step(const MagneticModel& model, MagneticState& state,
                                 const RelaxOptions& o, MagneticBackend& backend) {
+  if (!o.held_bodies.empty() && o.held_bodies.size() != static_cast<size_t>(model.body_count()))
+    throw std::invalid_argument("RelaxOptions::held_bodies: " + std::to_string(o.held_bodies.size()) +
+                                " entries for " + std::to_string(model.body_count()) + " bodies");
   place_cells(model, state);
   backend.set_far_field(o.far_field_theta);
   backend.set_near_field(o.near_field, o.mutual_induction);

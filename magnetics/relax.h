@@ -69,7 +69,9 @@ struct RelaxOptions {
   // and feel forces, and the relaxation converges on the others' cells.
   // The scene simulation's magnetic_solve "moving" holds, in a rigid step's
   // later substeps, every body that neither needs the substeps nor touches
-  // one that does (docs/simulation.md "Substeps").
+  // one that does (docs/simulation.md "Substeps"). Non-empty: one entry per
+  // body, or relax, magnetic_step and magnetic_forces_at_held_magnetization
+  // throw std::invalid_argument before they change anything.
   std::vector<uint8_t> held_bodies;
   LocalRelaxOptions local;
   // Called after every outer iteration with the report so far (iterations,

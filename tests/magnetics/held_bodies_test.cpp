@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 
 #include "magnetics/backend.h"
 #include "magnetics/constants.h"
@@ -148,4 +149,20 @@ TEST(HeldBodies, AHeldMomentTurnsWithItsBody) {
   ASSERT_TRUE(magnetic_step(model, state, options, *cpu).converged);
   const Vec3 turned = state.pose[0].rotation * before;
   EXPECT_LE(norm(state.magnetization[0] - turned), 1e-12 * norm(before));
+}
+
+// A held list that does not have one entry per body is refused, naming it.
+TEST(HeldBodies, AListOfTheWrongLengthThrows) {
+  ThreeBalls balls;
+  std::unique_ptr<MagneticBackend> cpu = make_cpu_backend(1);
+  balls.options.held_bodies = {0, 1};
+  try {
+    magnetic_step(balls.model, balls.state, balls.options, *cpu);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("held_bodies: 2 entries for 3 bodies"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(relax(balls.model, balls.state, balls.options, *cpu), std::invalid_argument);
+  EXPECT_THROW(magnetic_forces_at_held_magnetization(balls.model, balls.state, balls.options, *cpu),
+               std::invalid_argument);
 }
