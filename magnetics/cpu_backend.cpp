@@ -86,6 +86,7 @@ class CpuBackend final : public MagneticBackend {
   void set_far_field(double theta) override { far_field_theta_ = theta; }
   bool set_held_bodies(const std::vector<uint8_t>& held) override {
     held_ = held;
+    if (held_.empty()) held_cell_.clear();  // a non-empty set is followed by begin_step, which builds it
     return true;
   }
   void set_near_field(bool on, bool mutual_induction) override {

@@ -152,6 +152,27 @@ TEST(HeldBodies, AHeldMomentTurnsWithItsBody) {
 }
 
 // A held list that does not have one entry per body is refused, naming it.
+// After a step that held bodies, the backend's field sums cover every cell
+// again, the near-field pairs of two once-held touching balls included: the
+// same field as a backend that never held anything.
+TEST(HeldBodies, TheNearFieldOfHeldPairsReturnsAfterTheStep) {
+  ThreeBalls balls;
+  balls.state.pose[1].position = {0.0105, 0.0, 0.0};  // a, b and c in a touching row
+  balls.state.pose[2].position = {0.021, 0.0, 0.0};
+  std::unique_ptr<MagneticBackend> cpu = make_cpu_backend(1), fresh = make_cpu_backend(1);
+  // Relaxed first: a saturated ball (as made) carries no near-field correction.
+  ASSERT_TRUE(magnetic_step(balls.model, balls.state, balls.options, *cpu).converged);
+  balls.state.pose[0].position.x -= 0.0002;
+  balls.options.held_bodies = {0, 1, 1};
+  ASSERT_TRUE(magnetic_step(balls.model, balls.state, balls.options, *cpu).converged);
+  balls.options.held_bodies.clear();
+  fresh->begin_step(balls.model, balls.state);
+  std::vector<Vec3> H(balls.model.cell_count()), H_fresh(balls.model.cell_count());
+  cpu->responsive_field(balls.model, balls.state, H);
+  fresh->responsive_field(balls.model, balls.state, H_fresh);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(norm(H[c] - H_fresh[c]), 0.0) << "cell " << c;
+}
+
 TEST(HeldBodies, AListOfTheWrongLengthThrows) {
   ThreeBalls balls;
   std::unique_ptr<MagneticBackend> cpu = make_cpu_backend(1);
