@@ -42,12 +42,13 @@ class MagneticBackend {
   virtual void set_near_field(bool on, bool mutual_induction) = 0;
 
   // Bodies whose magnetization the next relaxations keep (RelaxOptions::
-  // held_bodies; by body, 1: held; empty: none), taking effect at once;
-  // relax and magnetic_step set it and reset it to none when they end. A
-  // backend that returns true neither relaxes their cells nor needs their
-  // rows of the responsive field; the default relaxes every cell, a held one
-  // under its last applied field (the relaxation passes that), which keeps it
-  // where it was up to the body's turn.
+  // held_bodies; by body, 1: held, 2: held and its force not needed; empty:
+  // none), taking effect at once; relax and magnetic_step set it and reset it
+  // to none when they end. A backend that returns true neither relaxes their
+  // cells nor needs their rows of the responsive field, and may leave the
+  // forces of bodies held with 2 at any value (the caller keeps theirs); the
+  // default relaxes every cell, a held one under its last applied field (the
+  // relaxation passes that), which keeps it where it was up to the body's turn.
   virtual bool set_held_bodies(const std::vector<uint8_t>& held) {
     (void)held;
     return false;

@@ -65,13 +65,19 @@ struct RelaxOptions {
   // start"). false: from the warm start's field, as before.
   bool predict_warm_start = true;
   // Bodies whose magnetization is kept, turned with the body but not solved
-  // for (by body index, 1: held; empty: none): their cells act as sources
+  // for (by body index, kHeld: held; empty: none): their cells act as sources
   // and feel forces, and the relaxation converges on the others' cells.
+  // kHeldKeepForce: held, and its force and torque are not needed (a body
+  // that the rigid step moved whole): they keep their values, and a backend
+  // may skip what only they need (the near-field pairs of two such bodies).
   // The scene simulation's magnetic_solve "moving" holds, in a rigid step's
   // later substeps, every body that neither needs the substeps nor touches
-  // one that does (docs/simulation.md "Substeps"). Non-empty: one entry per
-  // body, or relax, magnetic_step and magnetic_forces_at_held_magnetization
-  // throw std::invalid_argument before they change anything.
+  // one that does, and rigid_substeps "moving" keeps the forces of the bodies
+  // that took the step whole (docs/simulation.md "Substeps"). Non-empty: one
+  // entry (0, kHeld or kHeldKeepForce) per body, or relax, magnetic_step and
+  // magnetic_forces_at_held_magnetization throw std::invalid_argument
+  // before they change anything.
+  static constexpr uint8_t kHeld = 1, kHeldKeepForce = 2;
   std::vector<uint8_t> held_bodies;
   LocalRelaxOptions local;
   // Called after every outer iteration with the report so far (iterations,

@@ -378,6 +378,10 @@ struct SpherePairSlope {
   double dk[6] = {};                 // dK/dd, 1/m^4
   double d0 = 0.0;                   // where k0, dk and contact were evaluated
   double k0[6] = {};                 // K at d0 (a carried pair's K is k0 + dk (d - d0))
+  // Not evaluated at this build (two spheres whose forces are kept,
+  // NearFieldTerm::set_held_cells): k is zero, and the entry is kept for a
+  // later build's carry-over only.
+  bool stale = false;
 };
 
 // Each sphere's dipole p = V M and room below saturation max(0, Ms - |M|) at
@@ -463,10 +467,24 @@ class SphereNearField final : public NearFieldTerm {
             SpherePairSlope& ps = slopes_.emplace_back(q);
             p.sa = i, p.sb = j;
             ps.d = d;
+            ps.stale = false;
             p.u = u;
             for (int s = 0; s < 6; ++s) p.k[s] = ps.k0[s] + ps.dk[s] * delta;
             continue;
           }
+        }
+        // Two spheres whose forces are kept: nothing reads this pair before
+        // the next build, so it is not evaluated (its last evaluation kept).
+        if (both_keep_force(ca.cell, cb.cell)) {
+          if (next_previous < previous_slopes_.size() &&
+              std::make_pair(previous_slopes_[next_previous].a, previous_slopes_[next_previous].b) == key) {
+            SpherePair& p = pairs_.emplace_back(previous_[next_previous]);
+            SpherePairSlope& ps = slopes_.emplace_back(previous_slopes_[next_previous]);
+            p.sa = i, p.sb = j;
+            std::fill(p.k, p.k + 6, 0.0);
+            ps.stale = true;
+          }
+          continue;
         }
         if (ca.type != last_types.first || cb.type != last_types.second) {  // most pairs repeat the last type
           last_types = {ca.type, cb.type};
@@ -512,6 +530,7 @@ class SphereNearField final : public NearFieldTerm {
     for (size_t q = 0; q < pairs_.size(); ++q) {
       const SpherePair& p = pairs_[q];
       const SpherePairSlope& ps = slopes_[q];
+      if (ps.stale) continue;
       const double sigma = saturation_factor(m, p);
       const Vec3 &pa = m.dipole[p.sa], &pb = m.dipole[p.sb];
       // F_b = +mu0/2 sigma grad_r (sum_xy p_x . K_xy p_y), F_a = -F_b.

@@ -280,7 +280,8 @@ const std::vector<std::string>& summary_figures() {
     std::vector<std::string> f = {"bodies", "cells", "responsive_cells", "time_step", "duration", "steps",
                                   "frames", "wall_seconds", "steps_not_converged", "magnetic_steps_skipped",
                                   "exact_solver_failures"};
-    for (const char* group : {"magnetic_ms", "rigid_ms", "iterations", "substeps", "sleeping", "held"})
+    for (const char* group : {"magnetic_ms", "rigid_ms", "iterations", "substeps", "sleeping", "held",
+                              "whole_step"})
       for (const char* s : {"median", "p90", "mean", "max", "total"}) f.push_back(std::string(group) + "." + s);
     return f;
   }();
@@ -348,7 +349,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
 
   // summary.json: the cost of every rigid step and the scene's outcomes
   // (summary_figures() lists its numbers for sweeps: keep the two together).
-  std::vector<double> tm, tr, iterations, substeps, sleeping, held;
+  std::vector<double> tm, tr, iterations, substeps, sleeping, held, whole_step;
   long not_converged = 0, skipped = 0;
   for (const StepRecord& r : sim.records()) {
     tm.push_back(r.magnetic_ms);
@@ -357,6 +358,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
     substeps.push_back(r.substeps);
     sleeping.push_back(r.sleeping);
     held.push_back(r.held);
+    whole_step.push_back(r.whole_step);
     if (!r.converged) ++not_converged;
     skipped += r.skipped;
   }
@@ -382,6 +384,8 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
       {"substeps", statistics(substeps)},  // one relaxation per substep
       {"sleeping", statistics(sleeping)},  // bodies asleep at a step's end (simulation.sleep)
       {"held", statistics(held)},  // bodies held over a step's later substeps (magnetic_solve "moving")
+      // free bodies that took the step whole (rigid_substeps "moving")
+      {"whole_step", statistics(whole_step)},
       {"steps_not_converged", not_converged},
       {"magnetic_steps_skipped", skipped},  // substeps, with solver.skip_unchanged
       {"exact_solver_failures", sim.world().exact_solver_failures()},  // substeps QuickStep took instead

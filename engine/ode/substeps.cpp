@@ -92,6 +92,10 @@ int SubstepRule::needed_by(int b, double dt, const SubstepMotion& motion, double
   return substeps_for(dt, longest_substep(b, dt, motion, gravity, external_field, clearance));
 }
 
+double SubstepRule::hold_time(double dt) const {
+  return 2.0 * kPi * dt / std::max(settings_.stiffness_limit, 1e-9);
+}
+
 int SubstepRule::update(int wanted, double time, double dt, bool step_start) {
   // The count rises at once when needed but falls only at the start of a
   // step, after a lower count has sufficed for a while, to the largest count
@@ -101,7 +105,7 @@ int SubstepRule::update(int wanted, double time, double dt, bool step_start) {
   // swinging in a uniform field of 1e5 A/m gained 21 times its swing energy
   // in 2 s). The hold is one period of the slowest oscillation whose
   // stiffness alone asks for more than one substep, 2 pi dt / stiffness_limit.
-  const double hold = 2.0 * kPi * dt / std::max(settings_.stiffness_limit, 1e-9);
+  const double hold = hold_time(dt);
   const int needed = std::min(wanted, std::max(1, settings_.max_substeps));
   if (needed >= count_) {
     count_ = needed;

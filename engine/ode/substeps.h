@@ -78,6 +78,9 @@ class SubstepRule {
   // 1 .. max(1, max_substeps).
   int update(int wanted, double time, double dt, bool step_start);
   int count() const { return count_; }
+  // The hold time of update(), s: one period of the slowest oscillation whose
+  // stiffness alone asks for more than one substep of dt.
+  double hold_time(double dt) const;
 
  private:
   // The longest admissible substep of body b, at most `shortest` (s): the

@@ -1002,6 +1002,8 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
      .doc = {"number", "", "`1`"}},
     {.name = "magnetic_solve", .check = Check::choice, .slot = SLOT(magnetic_solve),
      .words = {"substep", "step", "moving"}, .doc = {"string", "", "`\"substep\"`"}},
+    {.name = "rigid_substeps", .check = Check::choice, .slot = SLOT(rigid_substeps),
+     .words = {"all", "moving"}, .doc = {"string", "", "`\"all\"`"}},
 };
 
 const KeyTable<CameraSettings> kCameraKeys = {

@@ -120,6 +120,11 @@ struct SimulationSettings {
   // substeps recomputing forces and torques at the new positions with the
   // magnetization of the step's start.
   std::string magnetic_solve = "substep";
+  // Which bodies take the substeps (docs/simulation.md "Substeps"): "all";
+  // or "moving", the free bodies that need them (for this and the last hold
+  // time) and those touching one, while every other free body takes the
+  // rigid step whole, a fixed support for the substeps.
+  std::string rigid_substeps = "all";
 };
 
 // A keyframe of a scripted (kinematic) body.

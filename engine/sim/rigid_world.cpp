@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <variant>
 
 #include "engine/ode/magnetic_forces.h"
@@ -204,15 +206,66 @@ void RigidWorld::update_forces(double time, double dt) {
   for (ForceAccumulator* a : accumulators_) a->update(time, dt);
 }
 
-void RigidWorld::integrate(double h) {
+bool RigidWorld::can_ride(int i) const {
+  const Body& b = bodies_[i];
+  return b.rides || (b.enabled && !b.kinematic && !b.jointed && !b.sleeping);
+}
+
+void RigidWorld::ride(const std::vector<uint8_t>& by_body) {
+  if (!by_body.empty() && by_body.size() != bodies_.size())
+    throw std::invalid_argument("RigidWorld::ride: " + std::to_string(by_body.size()) + " entries for " +
+                                std::to_string(bodies_.size()) + " bodies");
+  for (int i = 0; i < body_count(); ++i) {
+    Body& b = bodies_[i];
+    const bool rides = !by_body.empty() && by_body[i] && can_ride(i);
+    if (rides == b.rides) continue;
+    b.rides = rides;
+    if (rides) {
+      dBodySetKinematic(b.body);
+    } else {
+      dBodySetDynamic(b.body);
+    }
+  }
+  rider_touching_.clear();
+  rider_touching_kinematic_.clear();
+  riders_in_contact_.clear();
+  if (by_body.empty()) return;
+  for (const auto& [a, b] : touching_)
+    if (bodies_[a].rides && bodies_[b].rides) rider_touching_.emplace_back(a, b);
+  for (const auto& [a, k] : touching_kinematic_)
+    if (bodies_[a].rides) rider_touching_kinematic_.emplace_back(a, k);
+  for (int i = 0; i < body_count(); ++i)
+    if (bodies_[i].rides && bodies_[i].in_contact) riders_in_contact_.push_back(i);
+}
+
+RigidWorld::Motion RigidWorld::motion(int i) const {
+  Motion m;
+  const dBodyID b = bodies_[i].body;
+  std::copy_n(dBodyGetPosition(b), 3, m.position);
+  std::copy_n(dBodyGetQuaternion(b), 4, m.orientation);
+  m.velocity = velocity(i);
+  m.angular_velocity = angular_velocity(i);
+  return m;
+}
+
+void RigidWorld::set_motion(int i, const Motion& m) {
+  const dBodyID b = bodies_[i].body;
+  dBodySetPosition(b, m.position[0], m.position[1], m.position[2]);
+  dBodySetQuaternion(b, m.orientation);
+  dBodySetLinearVel(b, m.velocity.x, m.velocity.y, m.velocity.z);
+  dBodySetAngularVel(b, m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z);
+}
+
+void RigidWorld::integrate(double h, bool move_kinematic) {
   // Sleeping bodies are enabled while the accumulators add their forces, so
   // that a change of those forces can wake them (wake_on_force_change).
   for (Body& b : bodies_)
     if (b.sleeping) dBodyEnable(b.body);
   for (ForceAccumulator* a : accumulators_) a->add_forces();
   for (Body& b : bodies_) b.in_contact = false, b.contacts = 0, b.touches_kinematic = false;
-  touching_.clear();
-  touching_kinematic_.clear();
+  touching_ = rider_touching_;  // riders are not collided with each other (ride)
+  touching_kinematic_ = rider_touching_kinematic_;
+  for (int i : riders_in_contact_) bodies_[i].in_contact = true;
   if (sleep_.time > 0.0) wake_on_force_change();
   // ODE's random numbers (dWorldQuickStep reorders constraints randomly) come
   // from one seed per process: each world keeps its own sequence, so a run
@@ -235,10 +288,27 @@ void RigidWorld::integrate(double h) {
     }
     damped_step_ = h;
   }
+  struct KinematicPose {
+    dBodyID body;
+    dVector3 position;
+    dQuaternion orientation;
+  };
+  std::vector<KinematicPose> kinematic_poses;
+  if (!move_kinematic)
+    for (const Body& b : bodies_)
+      if (b.kinematic) {
+        KinematicPose& k = kinematic_poses.emplace_back(KinematicPose{b.body, {}, {}});
+        std::copy_n(dBodyGetPosition(b.body), 3, k.position);
+        std::copy_n(dBodyGetQuaternion(b.body), 4, k.orientation);
+      }
   if (exact_solver_) {
     exact_step_->step(ode_bodies_, h);  // QuickStep where ODE's exact solver fails
   } else {
     dWorldQuickStep(world_, h);
+  }
+  for (const KinematicPose& k : kinematic_poses) {
+    dBodySetPosition(k.body, k.position[0], k.position[1], k.position[2]);
+    dBodySetQuaternion(k.body, k.orientation);
   }
   dJointGroupEmpty(contacts_);
   if (sleep_.time > 0.0) update_sleep(h);
@@ -269,9 +339,11 @@ double RigidWorld::clearance(int i) const {
 void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
   auto* self = static_cast<RigidWorld*>(data);
   dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
-  const bool a_moves = ba && !dBodyIsKinematic(ba);
-  const bool b_moves = bb && !dBodyIsKinematic(bb);
-  if (!a_moves && !b_moves) return;  // nothing to resolve between immovable things
+  // Nothing to resolve between immovable things (kinematic in ODE: riders too).
+  if (!(ba && !dBodyIsKinematic(ba)) && !(bb && !dBodyIsKinematic(bb))) return;
+  // Dynamic bodies of the scene (a rider is one): for touching().
+  const bool a_moves = ba && (!dBodyIsKinematic(ba) || self->bodies_[self->index_of(ba)].rides);
+  const bool b_moves = bb && (!dBodyIsKinematic(bb) || self->bodies_[self->index_of(bb)].rides);
   // Jointed bodies do not collide with each other (a needle on its pivot).
   if (self->has_joints_ && ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
   dContact contact[kMaxContacts];
@@ -372,7 +444,7 @@ void RigidWorld::update_sleep(double h) {
   std::vector<double> speeds(n, 0.0);
   for (int i = 0; i < n; ++i) {
     Body& b = bodies_[i];
-    if (b.sleeping) continue;
+    if (b.sleeping || b.rides) continue;
     speeds[i] = speed(i);
     const bool candidate = b.enabled && !b.kinematic && !b.jointed && b.in_contact && !b.touches_kinematic;
     b.idle = candidate && speeds[i] <= sleep_.speed ? b.idle + h : 0.0;
@@ -390,7 +462,7 @@ void RigidWorld::update_sleep(double h) {
       if (fast_neighbour[i]) wake(i);
       continue;
     }
-    if (b.idle < sleep_.time || fast_neighbour[i]) continue;
+    if (b.rides || b.idle < sleep_.time || fast_neighbour[i]) continue;
     b.sleeping = true;
     b.rest_force = b.force;
     b.rest_torque = b.torque;

@@ -52,8 +52,32 @@ class RigidWorld {
   // update_forces() recomputes every accumulator's forces; integrate(h) adds
   // them to the bodies, collides, runs dWorldQuickStep(h) and empties the
   // contacts. A step may integrate several substeps with one update.
+  // move_kinematic = false: the kinematic bodies end where they began (their
+  // velocities still act on the contacts), for a step that covers a time the
+  // kinematic bodies cover in other integrate() calls (freeze).
   void update_forces(double time, double dt);
-  void integrate(double h);
+  void integrate(double h, bool move_kinematic = true);
+
+  // Riding bodies (simulation.rigid_substeps "moving", docs/simulation.md
+  // "Substeps"): bodies that took the rigid step whole and follow a given
+  // path, kinematic in ODE, through the substeps of the others: contacts
+  // with them see their velocity but do not move them. by_body: 1 for each
+  // body to ride, one entry per body, or empty: none (they are dynamic
+  // again, each with the velocity it was last given). Only free dynamic
+  // bodies (not kinematic, disabled, asleep or jointed) ride, others are
+  // ignored. The pairs of riders that touched in the last integrate() stay
+  // in touching() (they are not collided while both ride).
+  void ride(const std::vector<uint8_t>& by_body);
+  bool riding(int i) const { return bodies_[i].rides; }
+  bool can_ride(int i) const;
+
+  // A body's pose and velocities as ODE holds them, to put it back.
+  struct Motion {
+    dReal position[3], orientation[4];
+    Vec3 velocity, angular_velocity;
+  };
+  Motion motion(int i) const;
+  void set_motion(int i, const Motion& m);
 
   // Whether the body sleeps (docs/simulation.md "Sleeping bodies"): taken
   // out of ODE's step, at rest, until its applied force or torque moves by
@@ -100,6 +124,7 @@ class RigidWorld {
     bool jointed = false;      // held by a scene joint: never sleeps
     bool sleeping = false;
     bool touches_kinematic = false;  // in the last integrate()
+    bool rides = false;        // kinematic in ODE along a given path (ride)
     double idle = 0.0;         // s below the sleep speed, in contact
     Vec3 force, torque;        // applied (accumulators) in the last integrate()
     Vec3 rest_force, rest_torque;  // applied when it fell asleep
@@ -134,6 +159,10 @@ class RigidWorld {
   // Pairs of dynamic bodies in contact in the last integrate().
   std::vector<std::pair<int, int>> touching_;
   std::vector<std::pair<int, int>> touching_kinematic_;  // (dynamic, kinematic)
+  // While bodies ride: the pairs above of riders only, and riders in contact,
+  // from the integrate() before they rode.
+  std::vector<std::pair<int, int>> rider_touching_, rider_touching_kinematic_;
+  std::vector<int> riders_in_contact_;
   struct FoundContact {
     dContact contact;
     dBodyID a, b;  // nullptr: the ground

@@ -24,14 +24,17 @@ Quaternion slerp(const Quaternion& a, const Quaternion& b, double u) {
   return {q.w(), q.x(), q.y(), q.z()};
 }
 
-// Angular velocity that turns rotation A into rotation B in time dt.
+// Angular velocity that turns rotation A into rotation B in time dt, the
+// shorter way. The increment R = B A^T has R - R^T = 2 sin(angle) [n]x and
+// trace 1 + 2 cos(angle); atan2 keeps the angle accurate where it is tiny
+// (a resting body's step), where acos of the trace loses it.
 Vec3 angular_velocity_between(const Mat3& A, const Mat3& B, double dt) {
   const Mat3 R = B * A.transposed();  // world-frame increment
-  const double c = std::clamp((R.m[0][0] + R.m[1][1] + R.m[2][2] - 1.0) / 2.0, -1.0, 1.0);
-  const double angle = std::acos(c);
-  if (angle < 1e-12) return {};
   const Vec3 axis{R.m[2][1] - R.m[1][2], R.m[0][2] - R.m[2][0], R.m[1][0] - R.m[0][1]};
-  return (angle / (dt * norm(axis))) * axis;
+  const double two_sin = norm(axis);
+  if (two_sin == 0.0) return {};  // no turn (or exactly half a turn: no shorter way)
+  const double angle = std::atan2(0.5 * two_sin, 0.5 * (R.m[0][0] + R.m[1][1] + R.m[2][2] - 1.0));
+  return (angle / (dt * two_sin)) * axis;
 }
 
 }  // namespace
@@ -138,8 +141,9 @@ void Simulation::apply_timeline(double dt) {
 void Simulation::update_substep_motion() {
   for (int b = 0; b < world_->body_count(); ++b) {
     SubstepMotion& m = substep_motion_[b];
-    // A sleeping body does not move (docs/simulation.md "Sleeping bodies").
-    m.free = !world_->kinematic(b) && world_->enabled(b) && !world_->sleeping(b);
+    // A sleeping body does not move (docs/simulation.md "Sleeping bodies"),
+    // a riding one moves on a given path ("Substeps").
+    m.free = !world_->kinematic(b) && world_->enabled(b) && !world_->sleeping(b) && !world_->riding(b);
     if (!m.free) continue;
     m.mass = world_->mass(b);
     m.velocity = world_->velocity(b);
@@ -174,6 +178,69 @@ std::vector<uint8_t> Simulation::bodies_to_hold(double dt) {
   for (const auto& [a, k] : world_->touching_kinematic())
     if (moving[a]) held[k] = 0;
   return held;
+}
+
+std::vector<uint8_t> Simulation::bodies_to_step_whole(double dt) {
+  update_substep_motion();
+  const int n = world_->body_count();
+  moving_until_.resize(n, -1.0);
+  std::vector<uint8_t> moving(n, 0);
+  bool any_moving = false;
+  for (int b = 0; b < n; ++b) {
+    if (!substep_motion_[b].free) continue;
+    const int needed = substep_rule_.needed_by(b, dt, substep_motion_[b], norm(scene_.gravity),
+                                               norm(magnetics_->external_field()),
+                                               [this](int i) { return world_->clearance(i); });
+    if (needed > 1)
+      moving_until_[b] = time_ + substep_rule_.hold_time(dt);
+    // Held in the substeps for a hold time, so that a body's step does not
+    // follow the phase of its oscillation (SubstepRule::update).
+    moving[b] = time_ < moving_until_[b] * (1.0 - 1e-12) || !world_->can_ride(b);
+    any_moving = any_moving || moving[b];
+  }
+  if (!any_moving) return {};
+  std::vector<uint8_t> whole(n, 0);
+  for (int b = 0; b < n; ++b) whole[b] = substep_motion_[b].free && !moving[b];
+  for (const auto& [a, b] : world_->touching())
+    if (moving[a] || moving[b]) whole[a] = whole[b] = 0;
+  return whole;
+}
+
+void Simulation::step_slow_bodies_whole(double dt, StepRecord& record) {
+  const std::vector<uint8_t> whole = bodies_to_step_whole(dt);
+  if (std::count(whole.begin(), whole.end(), 1) == 0) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  // One step of dt for every body, as with one substep: the bodies that take
+  // it whole keep theirs, the others go back to the step's start.
+  const int n = world_->body_count();
+  std::vector<RigidWorld::Motion> start(n);
+  std::vector<BodyPose> start_pose(n);
+  for (int b = 0; b < n; ++b)
+    if (substep_motion_[b].free) start[b] = world_->motion(b), start_pose[b] = world_->pose(b);
+  world_->integrate(dt, false);
+  note_non_finite(time_ + dt);
+  whole_.assign(n, 0);
+  whole_end_.assign(n, {});
+  for (int b = 0; b < n && non_finite_body_ < 0; ++b) {
+    if (!substep_motion_[b].free) continue;
+    if (!whole[b]) {
+      world_->set_motion(b, start[b]);
+      continue;
+    }
+    // Through the substeps it rides from its start to its end on a straight
+    // path at constant velocities (kinematic: the substeps' contacts see its
+    // motion), and it ends the step with the state of its own step.
+    whole_end_[b] = world_->motion(b);
+    const BodyPose end_pose = world_->pose(b);
+    RigidWorld::Motion path = start[b];
+    path.velocity = (1.0 / dt) * (end_pose.position - start_pose[b].position);
+    path.angular_velocity = angular_velocity_between(start_pose[b].rotation, end_pose.rotation, dt);
+    world_->set_motion(b, path);
+    whole_[b] = 1;
+    ++record.whole_step;
+  }
+  world_->ride(whole_);
+  record.rigid_ms += elapsed_ms(t0);
 }
 
 void Simulation::update_substeps(double dt, bool step_start, StepRecord& record) {
@@ -214,6 +281,7 @@ void Simulation::step() {
   update_forces(time_, dt, true);
   if (steps_ == 0) outcomes_.sample(scene_, time_, dt, *world_, *magnetics_);  // t = 0, relaxed
   update_substeps(dt, true, record);
+  if (scene_.simulation.rigid_substeps == "moving" && substeps_ > 1) step_slow_bodies_whole(dt, record);
   // Substeps, each with its own forces: holding one step's forces over
   // several substeps is not symplectic and makes resting contacts unstable
   // (docs/simulation.md "Substeps"). The count is checked again after every
@@ -222,7 +290,7 @@ void Simulation::step() {
   // falling onto a magnet reached it within one 4 ms step and was thrown out).
   double done = 0.0;
   record.substeps = 0;
-  while (true) {
+  while (non_finite_body_ < 0) {
     const double h = std::min(dt / substeps_, dt - done);
     // T_r: collision, dWorldQuickStep, contacts.
     const auto t0 = std::chrono::steady_clock::now();
@@ -233,14 +301,25 @@ void Simulation::step() {
     // A NaN stops the step: ODE's collision would abort on it.
     note_non_finite(time_ + done);
     if (dt - done <= 1e-9 * dt || non_finite_body_ >= 0) break;
-    if (hold_slow_bodies) {
-      std::vector<uint8_t>& held = magnetics_->options().held_bodies = bodies_to_hold(dt);
-      for (size_t b = 0; b < held.size(); ++b)
+    if (hold_slow_bodies || record.whole_step > 0) {
+      // A riding body's magnetization is held too, and its force kept: it is
+      // not used before the next step.
+      std::vector<uint8_t>& held = magnetics_->options().held_bodies =
+          hold_slow_bodies ? bodies_to_hold(dt) : std::vector<uint8_t>(world_->body_count(), 0);
+      for (size_t b = 0; b < held.size(); ++b) {
+        if (world_->riding(static_cast<int>(b))) held[b] = RelaxOptions::kHeldKeepForce;
         record.held += held[b] && magnetics_->model().body(static_cast<int>(b)).responsive();
+      }
     }
     update_forces(time_ + done, dt / substeps_, relax_every_substep);
     magnetics_->options().held_bodies.clear();
     update_substeps(dt, false, record);
+  }
+  if (!whole_.empty()) {  // the bodies that took the step whole end it in their own state
+    world_->ride({});
+    for (int b = 0; b < world_->body_count(); ++b)
+      if (whole_[b]) world_->set_motion(b, whole_end_[b]);
+    whole_.clear();
   }
   record.sleeping = world_->sleeping_count();
   records_.push_back(record);

@@ -32,6 +32,7 @@ struct StepRecord {
   int relaxations = 0;       // substeps that relaxed the magnetization (SimulationSettings::magnetic_solve)
   int skipped = 0;           // substeps whose magnetic step was skipped (solver.skip_unchanged)
   int held = 0;              // magnetic_solve "moving": induced bodies held, summed over the later substeps
+  int whole_step = 0;        // rigid_substeps "moving": free bodies that took the step whole
   bool converged = true;
   double residual = 0.0;
   int sleeping = 0;          // bodies asleep at the step's end (SleepSettings)
@@ -86,6 +87,16 @@ class Simulation {
   // later substep holds: all but the free bodies that alone need more than
   // one substep of dt and the free bodies touching them.
   std::vector<uint8_t> bodies_to_hold(double dt);
+  // rigid_substeps "moving": by body, 1 for every free body that takes the
+  // rigid step whole: all but those that needed more than one substep of dt
+  // within the last hold time (SubstepRule::hold_time) and those touching
+  // them. Empty when no body would take the substeps.
+  std::vector<uint8_t> bodies_to_step_whole(double dt);
+  // With rigid_substeps "moving" and more than one substep: one step of dt
+  // for every free body; the bodies_to_step_whole keep it (whole_end_) and
+  // ride through the substeps from their start to there, the others go back
+  // to the step's start for their substeps.
+  void step_slow_bodies_whole(double dt, StepRecord& record);
   // Sets substeps_ from substeps_needed through the rule (capped: raised at
   // once, lowered only at a step's start after a hold time); notes the
   // uncapped need in record.substeps_wanted.
@@ -111,6 +122,13 @@ class Simulation {
   SubstepRule substep_rule_;
   std::vector<SubstepMotion> substep_motion_;
   int substeps_ = 1;
+  // rigid_substeps "moving": by body, the time until which it counts as
+  // needing the substeps (the last time it needed them plus the hold time).
+  std::vector<double> moving_until_;
+  // In a rigid step: by body, 1 for a body that took it whole (empty: none),
+  // and the state it ends the step in.
+  std::vector<uint8_t> whole_;
+  std::vector<RigidWorld::Motion> whole_end_;
   // The first body found non-finite (-1 while none), its step and time.
   int non_finite_body_ = -1;
   long non_finite_step_ = 0;

@@ -177,6 +177,7 @@ class PySimulation {
     d["residual"] = double_array(column(&StepRecord::residual));
     d["sleeping"] = copied_array<int>(column(&StepRecord::sleeping));
     d["held"] = copied_array<int>(column(&StepRecord::held));
+    d["whole_step"] = copied_array<int>(column(&StepRecord::whole_step));
     return d;
   }
 

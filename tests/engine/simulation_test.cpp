@@ -127,6 +127,72 @@ TEST_P(BallOntoMagnetMovingSolve, ComesToRestTouchingItWhileTheRestingBallIsHeld
 
 INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnetMovingSolve, ::testing::Values(0.001, 0.004, 0.010));
 
+// simulation.rigid_substeps "moving": the bodies that neither need the
+// substeps nor touch one that does take the rigid step whole and ride through
+// the others' substeps (docs/simulation.md "Substeps"). Beside the falling
+// ball, a wooden (inert) ball falls freely 15 cm away: it takes every step
+// whole, so its height after N steps is the closed form of ODE's
+// semi-implicit Euler step at dt, z0 - g dt^2 N (N + 1) / 2, whatever the
+// other ball's substeps; the falling ball comes to rest on the pole as before,
+// and a steel ball resting on a second one stays on it.
+class BallOntoMagnetRigidMoving : public ::testing::TestWithParam<double> {};
+
+TEST_P(BallOntoMagnetRigidMoving, TheFreeBallStepsWholeAndTheFallingBallComesToRest) {
+  const double dt = GetParam();
+  SceneDescription scene = ball_onto_magnet(dt);
+  scene.materials["wood"] = InertMaterial{};
+  const double z0 = 0.3;
+  scene.bodies.push_back(body("free", Sphere{0.005}, "wood", {0.15, 0.0, z0}, false, 700.0));
+  scene.bodies.push_back(body("below", Sphere{0.005}, "steel", {-0.1, 0.0, 0.005}));
+  scene.bodies.push_back(body("above", Sphere{0.005}, "steel", {-0.1, 0.0, 0.015}));
+  scene.simulation.magnetic_solve = "moving";
+  scene.simulation.rigid_substeps = "moving";
+  Simulation sim(scene);
+  const double g = norm(scene.gravity);
+  double closest = 1.0;
+  int split_steps = 0;
+  while (sim.time() < 1.5) {
+    sim.step();
+    for (int b = 0; b < 5; ++b) ASSERT_TRUE(sim.finite_state(b)) << "t=" << sim.time();
+    closest = std::min(closest, norm(sim.world().pose(1).position - Vec3{0, 0, 0.008}));
+    const StepRecord& r = sim.records().back();
+    if (r.substeps > 1) {
+      ++split_steps;
+      EXPECT_GE(r.whole_step, 1) << "t=" << sim.time();  // the free ball at least
+    }
+    if (sim.time() <= 0.2 + 1e-9) {  // before it comes near the ground (clearance: no substeps of its own)
+      const double n = static_cast<double>(sim.steps());
+      EXPECT_NEAR(sim.world().pose(2).position.z, z0 - 0.5 * g * dt * dt * n * (n + 1.0), 1e-9)
+          << "t=" << sim.time();
+    }
+  }
+  ASSERT_GT(split_steps, 0) << "dt=" << dt << ": the case never needed substeps";
+  expect_resting_on_the_pole(sim, closest, dt);
+  EXPECT_NEAR(sim.world().pose(4).position.z, 0.015, 2e-4) << "the upper ball stays on the lower one";
+  EXPECT_NEAR(sim.world().pose(4).position.x, -0.1, 2e-4);
+}
+
+INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnetRigidMoving, ::testing::Values(0.001, 0.004, 0.010));
+
+// With the default ("all") the free ball takes the substeps too: its height
+// leaves the closed form at dt (the test above tells the two apart).
+TEST(BallOntoMagnetRigidMoving, ByDefaultEveryBodyTakesTheSubsteps) {
+  const double dt = 0.004;
+  SceneDescription scene = ball_onto_magnet(dt);
+  scene.materials["wood"] = InertMaterial{};
+  scene.bodies.push_back(body("free", Sphere{0.005}, "wood", {0.15, 0.0, 0.3}, false, 700.0));
+  Simulation sim(scene);
+  int split_steps = 0;
+  while (sim.time() < 0.2) {
+    sim.step();
+    split_steps += sim.records().back().substeps > 1;
+    EXPECT_EQ(sim.records().back().whole_step, 0);
+  }
+  ASSERT_GT(split_steps, 0);
+  const double n = static_cast<double>(sim.steps());
+  EXPECT_GT(std::fabs(sim.world().pose(2).position.z - (0.3 - 0.5 * 9.81 * dt * dt * n * (n + 1.0))), 1e-6);
+}
+
 // With the default ("substep") every substep relaxes.
 TEST(BallOntoMagnet, EverySubstepRelaxesByDefault) {
   Simulation sim(ball_onto_magnet(0.004));

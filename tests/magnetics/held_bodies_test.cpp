@@ -151,11 +151,15 @@ TEST(HeldBodies, AHeldMomentTurnsWithItsBody) {
   EXPECT_LE(norm(state.magnetization[0] - turned), 1e-12 * norm(before));
 }
 
-// A held list that does not have one entry per body is refused, naming it.
 // After a step that held bodies, the backend's field sums cover every cell
 // again, the near-field pairs of two once-held touching balls included: the
 // same field as a backend that never held anything.
-TEST(HeldBodies, TheNearFieldOfHeldPairsReturnsAfterTheStep) {
+// So with RelaxOptions::kHeldKeepForce, whose pairs the step's build left
+// unevaluated.
+class HeldNearField : public ::testing::TestWithParam<uint8_t> {};
+
+TEST_P(HeldNearField, TheNearFieldOfHeldPairsReturnsAfterTheStep) {
+  const uint8_t hold = GetParam();
   ThreeBalls balls;
   balls.state.pose[1].position = {0.0105, 0.0, 0.0};  // a, b and c in a touching row
   balls.state.pose[2].position = {0.021, 0.0, 0.0};
@@ -163,7 +167,8 @@ TEST(HeldBodies, TheNearFieldOfHeldPairsReturnsAfterTheStep) {
   // Relaxed first: a saturated ball (as made) carries no near-field correction.
   ASSERT_TRUE(magnetic_step(balls.model, balls.state, balls.options, *cpu).converged);
   balls.state.pose[0].position.x -= 0.0002;
-  balls.options.held_bodies = {0, 1, 1};
+  balls.state.pose[2].position.x += 0.0002;  // b and c apart beyond the carry-over: a new evaluation
+  balls.options.held_bodies = {0, hold, hold};
   ASSERT_TRUE(magnetic_step(balls.model, balls.state, balls.options, *cpu).converged);
   balls.options.held_bodies.clear();
   fresh->begin_step(balls.model, balls.state);
@@ -173,6 +178,10 @@ TEST(HeldBodies, TheNearFieldOfHeldPairsReturnsAfterTheStep) {
   for (int c = 0; c < 3; ++c) EXPECT_EQ(norm(H[c] - H_fresh[c]), 0.0) << "cell " << c;
 }
 
+INSTANTIATE_TEST_SUITE_P(Holds, HeldNearField,
+                         ::testing::Values(RelaxOptions::kHeld, RelaxOptions::kHeldKeepForce));
+
+// A held list that does not have one entry per body is refused, naming it.
 TEST(HeldBodies, AListOfTheWrongLengthThrows) {
   ThreeBalls balls;
   std::unique_ptr<MagneticBackend> cpu = make_cpu_backend(1);
@@ -186,4 +195,50 @@ TEST(HeldBodies, AListOfTheWrongLengthThrows) {
   EXPECT_THROW(relax(balls.model, balls.state, balls.options, *cpu), std::invalid_argument);
   EXPECT_THROW(magnetic_forces_at_held_magnetization(balls.model, balls.state, balls.options, *cpu),
                std::invalid_argument);
+}
+
+// Held with RelaxOptions::kHeldKeepForce (a body the rigid step moved whole):
+// the relaxation and the other bodies' forces are those of kHeld, bit for bit,
+// and the held bodies keep the forces and torques they had, on the CPU
+// backend (which skips their force sums) and on one that computes every force.
+TEST(HeldBodies, BodiesHeldWithTheirForceKeepItAndTheOthersAreUnchanged) {
+  std::unique_ptr<MagneticBackend> cpu = make_cpu_backend(1);
+  RelaxesEveryCell every;
+  for (MagneticBackend* backend : {cpu.get(), static_cast<MagneticBackend*>(&every)}) {
+    SCOPED_TRACE(backend->name());
+    ThreeBalls held, kept;
+    ASSERT_TRUE(magnetic_step(held.model, held.state, held.options, *backend).converged);
+    kept.state = held.state;
+    for (ThreeBalls* balls : {&held, &kept}) {
+      balls->state.pose[1].position = {0.05, 0.01, 0.0};
+      balls->state.pose[2].position = {-0.01, 0.0, 0.05};
+    }
+    held.options.held_bodies = {0, RelaxOptions::kHeld, RelaxOptions::kHeld};
+    kept.options.held_bodies = {0, RelaxOptions::kHeldKeepForce, RelaxOptions::kHeldKeepForce};
+    const Vec3 force{1.0, 2.0, 3.0}, torque{-4.0, 5.0, -6.0};  // not a field's: must come back as they are
+    for (int b = 1; b < 3; ++b) kept.state.force[b] = force, kept.state.torque[b] = torque;
+    ASSERT_TRUE(magnetic_step(held.model, held.state, held.options, *backend).converged);
+    ASSERT_TRUE(magnetic_step(kept.model, kept.state, kept.options, *backend).converged);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(norm(kept.state.magnetization[c] - held.state.magnetization[c]), 0.0) << "cell " << c;
+    EXPECT_EQ(norm(kept.state.force[0] - held.state.force[0]), 0.0);
+    EXPECT_EQ(norm(kept.state.torque[0] - held.state.torque[0]), 0.0);
+    EXPECT_GT(norm(held.state.force[0]), 0.0);
+    for (int b = 1; b < 3; ++b) {
+      EXPECT_EQ(norm(kept.state.force[b] - force), 0.0) << "body " << b;
+      EXPECT_EQ(norm(kept.state.torque[b] - torque), 0.0) << "body " << b;
+    }
+  }
+}
+
+TEST(HeldBodies, AnEntryOtherThanZeroOneOrTwoThrows) {
+  ThreeBalls balls;
+  std::unique_ptr<MagneticBackend> cpu = make_cpu_backend(1);
+  balls.options.held_bodies = {0, 3, 0};
+  try {
+    magnetic_step(balls.model, balls.state, balls.options, *cpu);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("held_bodies: entry 1 is 3"), std::string::npos) << e.what();
+  }
 }
