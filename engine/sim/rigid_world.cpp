@@ -392,9 +392,11 @@ void RigidWorld::create_contact_joints() {
   }
   // A sleeping body is a fixed support for the bodies awake around it.
   auto sleeps = [this](dBodyID b) { return b && bodies_[index_of(b)].sleeping; };
+  // Neither of two such bodies moves in this step (a rider only along its path: ride).
+  auto fixed = [this](dBodyID b, bool asleep) { return asleep || !b || bodies_[index_of(b)].rides; };
   for (const FoundContact& f : found_) {
     const bool a_sleeps = sleeps(f.a), b_sleeps = sleeps(f.b);
-    if ((a_sleeps || !f.a) && (b_sleeps || !f.b)) continue;  // neither moves
+    if (fixed(f.a, a_sleeps) && fixed(f.b, b_sleeps)) continue;
     dJointID j = dJointCreateContact(world_, contacts_, &f.contact);
     dJointAttach(j, a_sleeps ? nullptr : f.a, b_sleeps ? nullptr : f.b);
   }
