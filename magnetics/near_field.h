@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "magnetics/model.h"
+#include "magnetics/relax.h"
 #include "magnetics/state.h"
 #include "magnetics/vec3.h"
 
@@ -77,10 +78,9 @@ class NearFieldTerm {
     return held_cells_ && !held_cells_->empty() && (*held_cells_)[a] && (*held_cells_)[b];
   }
   bool both_keep_force(int a, int b) const {
-    return held_cells_ && !held_cells_->empty() && (*held_cells_)[a] == kKeepForce &&
-           (*held_cells_)[b] == kKeepForce;
+    return held_cells_ && !held_cells_->empty() && (*held_cells_)[a] == RelaxOptions::kHeldKeepForce &&
+           (*held_cells_)[b] == RelaxOptions::kHeldKeepForce;
   }
-  static constexpr uint8_t kKeepForce = 2;  // RelaxOptions::kHeldKeepForce
   bool mutual_induction_ = true;
   const std::vector<uint8_t>* held_cells_ = nullptr;
 };

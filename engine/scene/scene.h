@@ -123,7 +123,7 @@ struct SimulationSettings {
   // Which bodies take the substeps (docs/simulation.md "Substeps"): "all";
   // or "moving", the free bodies that need them (for this and the last hold
   // time) and those touching one, while every other free body takes the
-  // rigid step whole, a fixed support for the substeps.
+  // rigid step whole and rides through the substeps on its path.
   std::string rigid_substeps = "all";
 };
 

@@ -288,28 +288,16 @@ void RigidWorld::integrate(double h, bool move_kinematic) {
     }
     damped_step_ = h;
   }
-  struct KinematicPose {
-    dBodyID body;
-    dVector3 position;
-    dQuaternion orientation;
-  };
-  std::vector<KinematicPose> kinematic_poses;
+  std::vector<std::pair<int, Motion>> kinematic_motions;  // put back after the step
   if (!move_kinematic)
-    for (const Body& b : bodies_)
-      if (b.kinematic) {
-        KinematicPose& k = kinematic_poses.emplace_back(KinematicPose{b.body, {}, {}});
-        std::copy_n(dBodyGetPosition(b.body), 3, k.position);
-        std::copy_n(dBodyGetQuaternion(b.body), 4, k.orientation);
-      }
+    for (int i = 0; i < body_count(); ++i)
+      if (bodies_[i].kinematic) kinematic_motions.emplace_back(i, motion(i));
   if (exact_solver_) {
     exact_step_->step(ode_bodies_, h);  // QuickStep where ODE's exact solver fails
   } else {
     dWorldQuickStep(world_, h);
   }
-  for (const KinematicPose& k : kinematic_poses) {
-    dBodySetPosition(k.body, k.position[0], k.position[1], k.position[2]);
-    dBodySetQuaternion(k.body, k.orientation);
-  }
+  for (const auto& [i, m] : kinematic_motions) set_motion(i, m);
   dJointGroupEmpty(contacts_);
   if (sleep_.time > 0.0) update_sleep(h);
   random_seed_ = dRandGetSeed();

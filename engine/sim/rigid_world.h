@@ -54,7 +54,8 @@ class RigidWorld {
   // contacts. A step may integrate several substeps with one update.
   // move_kinematic = false: the kinematic bodies end where they began (their
   // velocities still act on the contacts), for a step that covers a time the
-  // kinematic bodies cover in other integrate() calls (freeze).
+  // kinematic bodies cover in other integrate() calls (the whole step of
+  // rigid_substeps "moving").
   void update_forces(double time, double dt);
   void integrate(double h, bool move_kinematic = true);
 
