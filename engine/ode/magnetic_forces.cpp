@@ -246,20 +246,27 @@ void MagneticForces::note_reference(int b) {
 }
 
 void MagneticForces::add_forces() {
-  for (int b = 0; b < model_.body_count(); ++b) {
-    dBodyID body = bodies_[b];
-    if (!body || !state_.active[b] || model_.body(b).inert() || dBodyIsKinematic(body)) continue;
-    if (!dBodyIsEnabled(body)) {
-      if (!reference_known_[b]) note_reference(b);  // never seen awake: its forces now are the reference
-      if (!wakes(b)) continue;
-      dBodyEnable(body);
-    }
-    note_reference(b);
-    const Vec3& f = state_.force[b];
-    const Vec3& t = state_.torque[b];
-    dBodyAddForce(body, f.x, f.y, f.z);
-    dBodyAddTorque(body, t.x, t.y, t.z);
+  for (int b = 0; b < model_.body_count(); ++b) add_forces_of(b);
+}
+
+void MagneticForces::add_forces_to(dBodyID body) {
+  for (int b = 0; b < model_.body_count(); ++b)
+    if (bodies_[b] == body) add_forces_of(b);
+}
+
+void MagneticForces::add_forces_of(int b) {
+  dBodyID body = bodies_[b];
+  if (!body || !state_.active[b] || model_.body(b).inert() || dBodyIsKinematic(body)) return;
+  if (!dBodyIsEnabled(body)) {
+    if (!reference_known_[b]) note_reference(b);  // never seen awake: its forces now are the reference
+    if (!wakes(b)) return;
+    dBodyEnable(body);
   }
+  note_reference(b);
+  const Vec3& f = state_.force[b];
+  const Vec3& t = state_.torque[b];
+  dBodyAddForce(body, f.x, f.y, f.z);
+  dBodyAddTorque(body, t.x, t.y, t.z);
 }
 
 }  // namespace odemag

@@ -95,6 +95,8 @@ class MagneticForces : public ForceAccumulator {
   // approaches is woken. Bodies whose auto-disable flag is off (disabled by
   // the program, as the scene simulation removes bodies) are never woken.
   void add_forces() override;
+  // The same for one body, if it is one of the model's (ForceAccumulator).
+  void add_forces_to(dBodyID body) override;
   const RelaxReport& compute();
   // Forces and torques at the bodies' current poses with the magnetization of
   // the last compute() held (magnetic_forces_at_held_magnetization): no
@@ -159,6 +161,7 @@ class MagneticForces : public ForceAccumulator {
   bool wakes(int b) const;
   // add_forces: the body's force and torque become its F_0, T_0.
   void note_reference(int b);
+  void add_forces_of(int b);  // add_forces() for body b
 
   MagneticModel model_;
   MagneticState state_;

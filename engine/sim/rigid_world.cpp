@@ -229,9 +229,13 @@ void RigidWorld::ride(const std::vector<uint8_t>& by_body) {
   rider_touching_.clear();
   rider_touching_kinematic_.clear();
   riders_in_contact_.clear();
+  ride_start_touching_.clear();
   if (by_body.empty()) return;
-  for (const auto& [a, b] : touching_)
+  for (const auto& [a, b] : touching_) {
+    ride_start_touching_.emplace_back(std::min(a, b), std::max(a, b));
     if (bodies_[a].rides && bodies_[b].rides) rider_touching_.emplace_back(a, b);
+  }
+  std::sort(ride_start_touching_.begin(), ride_start_touching_.end());
   for (const auto& [a, k] : touching_kinematic_)
     if (bodies_[a].rides) rider_touching_kinematic_.emplace_back(a, k);
   for (int i = 0; i < body_count(); ++i)
@@ -274,6 +278,7 @@ void RigidWorld::integrate(double h, bool move_kinematic) {
   const unsigned long process_seed = dRandGetSeed();
   dRandSetSeed(random_seed_);
   dSpaceCollide(space_, this, &RigidWorld::near_callback);
+  if (!leaving_ride_.empty()) stop_riding_where_hit();
   create_contact_joints();
   // ODE damps once per step it takes: scaled so that the substeps of a rigid
   // step damp together by the scene's factor, whatever their count (each
@@ -324,9 +329,54 @@ double RigidWorld::clearance(int i) const {
   return std::sqrt(nearest);
 }
 
+void RigidWorld::stop_riding_where_hit() {
+  std::vector<int> leaving;
+  leaving.swap(leaving_ride_);
+  for (size_t k = 0; k < leaving.size(); ++k) {
+    Body& b = bodies_[leaving[k]];
+    b.rides = false;
+    b.recollide_rank = static_cast<int>(k);
+    b.leaves_ride = false;
+    dBodySetDynamic(b.body);  // with its path velocity
+    for (ForceAccumulator* a : accumulators_) a->add_forces_to(b.body);
+  }
+  // Their pairs with riders came from before the riding (ride) and are
+  // collided again below.
+  auto left = [this](int i) { return bodies_[i].recollide_rank >= 0; };
+  auto from_ride = [&](const std::pair<int, int>& p) {
+    return (left(p.first) || left(p.second)) && (left(p.first) || bodies_[p.first].rides) &&
+           (left(p.second) || bodies_[p.second].rides);
+  };
+  std::erase_if(touching_, from_ride);
+  std::erase_if(rider_touching_, from_ride);
+  std::erase_if(touching_kinematic_, [&](const auto& p) { return left(p.first); });
+  std::erase_if(rider_touching_kinematic_, [&](const auto& p) { return left(p.first); });
+  std::erase_if(riders_in_contact_, left);
+  // The pass above collided them with dynamic bodies only.
+  for (int i : leaving) {
+    recollided_ = i;
+    dSpaceCollide2(bodies_[i].geom, reinterpret_cast<dGeomID>(space_), this, &RigidWorld::near_callback);
+  }
+  recollided_ = -1;
+  for (int i : leaving) bodies_[i].recollide_rank = -1;
+}
+
 void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
   auto* self = static_cast<RigidWorld*>(data);
   dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
+  if (self->recollided_ >= 0) {
+    // A rider that stopped riding in this pass (stop_riding_where_hit) against
+    // what the pass skipped: the ground and static geoms, kinematic bodies,
+    // riders, and those that stopped riding after it.
+    const Body& own = self->bodies_[self->recollided_];
+    if (a == b) return;
+    const dBodyID other = dGeomGetBody(a) == own.body ? bb : ba;
+    if (other == own.body) return;
+    if (other && !dBodyIsKinematic(other)) {
+      const int rank = self->bodies_[self->index_of(other)].recollide_rank;
+      if (rank < 0 || rank < own.recollide_rank) return;
+    }
+  }
   // Nothing to resolve between immovable things (kinematic in ODE: riders too).
   if (!(ba && !dBodyIsKinematic(ba)) && !(bb && !dBodyIsKinematic(bb))) return;
   // Dynamic bodies of the scene (a rider is one): for touching().
@@ -337,6 +387,20 @@ void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
   dContact contact[kMaxContacts];
   const int n = dCollide(a, b, kMaxContacts, &contact[0].geom, sizeof(dContact));
   if (n == 0) return;
+  // A rider that a dynamic body runs into, having not touched it at the
+  // step's start, rides no more from this substep on: as a sleeping body
+  // would (create_contact_joints), it would stop the other like a wall.
+  if (self->recollided_ < 0 && a_moves && b_moves && dBodyIsKinematic(ba) != dBodyIsKinematic(bb)) {
+    const int rider = self->index_of(dBodyIsKinematic(ba) ? ba : bb);
+    const int other = self->index_of(dBodyIsKinematic(ba) ? bb : ba);
+    const std::pair<int, int> pair{std::min(rider, other), std::max(rider, other)};
+    Body& r = self->bodies_[rider];
+    if (!self->bodies_[other].sleeping && !r.leaves_ride &&
+        !std::binary_search(self->ride_start_touching_.begin(), self->ride_start_touching_.end(), pair)) {
+      r.leaves_ride = true;
+      self->leaving_ride_.push_back(rider);
+    }
+  }
   for (dBodyID body : {ba, bb})
     if (body) {
       Body& touched = self->bodies_[self->index_of(body)];

@@ -67,7 +67,10 @@ class RigidWorld {
   // again, each with the velocity it was last given). Only free dynamic
   // bodies (not kinematic, disabled, asleep or jointed) ride, others are
   // ignored. The pairs of riders that touched in the last integrate() stay
-  // in touching() (they are not collided while both ride).
+  // in touching() (they are not collided while both ride). A rider that a
+  // dynamic body runs into, which it did not touch when the riding began,
+  // rides no more from that substep on (riding() false): dynamic, with the
+  // velocity of its path, as a sleeping body that a faster one hits wakes.
   void ride(const std::vector<uint8_t>& by_body);
   bool riding(int i) const { return bodies_[i].rides; }
   bool can_ride(int i) const;
@@ -126,6 +129,8 @@ class RigidWorld {
     bool sleeping = false;
     bool touches_kinematic = false;  // in the last integrate()
     bool rides = false;        // kinematic in ODE along a given path (ride)
+    bool leaves_ride = false;  // a dynamic body ran into it in this collision pass
+    int recollide_rank = -1;   // its place among those (stop_riding_where_hit)
     double idle = 0.0;         // s below the sleep speed, in contact
     Vec3 force, torque;        // applied (accumulators) in the last integrate()
     Vec3 rest_force, rest_torque;  // applied when it fell asleep
@@ -138,6 +143,11 @@ class RigidWorld {
   // contact joints.
   static void near_callback(void* data, dGeomID a, dGeomID b);
   void create_contact_joints();
+  // After the collision pass: the riders a dynamic body ran into that it did
+  // not touch when they began to ride (leaving_ride_) are dynamic from this
+  // substep on, with their forces, and are collided with what the pass
+  // skipped for them (recollided_).
+  void stop_riding_where_hit();
   double speed(int i) const;  // |v| + |omega| r, m/s
   void wake(int i);
   // Before the step: wakes sleeping bodies whose applied force or torque moved.
@@ -164,6 +174,10 @@ class RigidWorld {
   // from the integrate() before they rode.
   std::vector<std::pair<int, int>> rider_touching_, rider_touching_kinematic_;
   std::vector<int> riders_in_contact_;
+  // The touching() pairs (lower index first, sorted) when they began to ride.
+  std::vector<std::pair<int, int>> ride_start_touching_;
+  std::vector<int> leaving_ride_;  // riders hit in this collision pass
+  int recollided_ = -1;            // the body stop_riding_where_hit collides, or -1
   struct FoundContact {
     dContact contact;
     dBodyID a, b;  // nullptr: the ground

@@ -180,11 +180,11 @@ std::vector<uint8_t> Simulation::bodies_to_hold(double dt) {
   return held;
 }
 
-std::vector<uint8_t> Simulation::bodies_to_step_whole(double dt) {
+std::vector<uint8_t> Simulation::bodies_to_step_whole(double dt, std::vector<uint8_t>& moving) {
   update_substep_motion();
   const int n = world_->body_count();
   moving_until_.resize(n, -1.0);
-  std::vector<uint8_t> moving(n, 0);
+  moving.assign(n, 0);
   bool any_moving = false;
   for (int b = 0; b < n; ++b) {
     if (!substep_motion_[b].free) continue;
@@ -207,7 +207,8 @@ std::vector<uint8_t> Simulation::bodies_to_step_whole(double dt) {
 }
 
 void Simulation::step_slow_bodies_whole(double dt, StepRecord& record) {
-  const std::vector<uint8_t> whole = bodies_to_step_whole(dt);
+  std::vector<uint8_t> moving;
+  std::vector<uint8_t> whole = bodies_to_step_whole(dt, moving);
   if (std::count(whole.begin(), whole.end(), 1) == 0) return;
   const auto t0 = std::chrono::steady_clock::now();
   // One step of dt for every body, as with one substep: the bodies that take
@@ -219,6 +220,10 @@ void Simulation::step_slow_bodies_whole(double dt, StepRecord& record) {
     if (substep_motion_[b].free) start[b] = world_->motion(b), start_pose[b] = world_->pose(b);
   world_->integrate(dt, false);
   note_non_finite(time_ + dt);
+  // Its contacts, found at the step's start positions, count too: those
+  // bodies_to_step_whole read were the last substep's.
+  for (const auto& [a, b] : world_->touching())
+    if (moving[a] || moving[b]) whole[a] = whole[b] = 0;
   whole_.assign(n, 0);
   whole_end_.assign(n, {});
   for (int b = 0; b < n && non_finite_body_ < 0; ++b) {
@@ -315,7 +320,11 @@ void Simulation::step() {
     magnetics_->options().held_bodies.clear();
     update_substeps(dt, false, record);
   }
-  if (!whole_.empty()) {  // the bodies that took the step whole end it in their own state
+  if (!whole_.empty()) {
+    // The bodies that rode to the end end the step in the state of their own
+    // step; those that a body ran into were stepped from there on.
+    for (int b = 0; b < world_->body_count(); ++b)
+      if (whole_[b] && !world_->riding(b)) whole_[b] = 0, --record.whole_step;
     world_->ride({});
     for (int b = 0; b < world_->body_count(); ++b)
       if (whole_[b]) world_->set_motion(b, whole_end_[b]);

@@ -90,12 +90,14 @@ class Simulation {
   // rigid_substeps "moving": by body, 1 for every free body that takes the
   // rigid step whole: all but those that needed more than one substep of dt
   // within the last hold time (SubstepRule::hold_time) and those touching
-  // them. Empty when no body would take the substeps.
-  std::vector<uint8_t> bodies_to_step_whole(double dt);
+  // them. Empty when no body would take the substeps. moving: 1 for each
+  // body that needed the substeps within the hold time.
+  std::vector<uint8_t> bodies_to_step_whole(double dt, std::vector<uint8_t>& moving);
   // With rigid_substeps "moving" and more than one substep: one step of dt
-  // for every free body; the bodies_to_step_whole keep it (whole_end_) and
-  // ride through the substeps from their start to there, the others go back
-  // to the step's start for their substeps.
+  // for every free body; the bodies_to_step_whole that touched no moving
+  // body in it either keep it (whole_end_) and ride through the substeps from
+  // their start to there, the others go back to the step's start for their
+  // substeps.
   void step_slow_bodies_whole(double dt, StepRecord& record);
   // Sets substeps_ from substeps_needed through the rule (capped: raised at
   // once, lowered only at a step's start after a hold time); notes the

@@ -174,6 +174,36 @@ TEST_P(BallOntoMagnetRigidMoving, TheFreeBallStepsWholeAndTheFallingBallComesToR
 
 INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnetRigidMoving, ::testing::Values(0.001, 0.004, 0.010));
 
+// A rider is not a wall: a wooden ball at 1 m/s (4 mm per 4 ms step, so it
+// takes substeps) runs head-on into an equal one at rest, which takes its
+// steps whole and rides until the impact (no gravity, no ground). With it
+// dynamic again from the substep of the impact, the two share the momentum
+// as a collision with restitution e does: v_front = v0 (1 + e) / 2, v_back =
+// v0 (1 - e) / 2 (e = the contact's restitution, 0.1), and the total m v0 is
+// kept to ODE's rounding. (A wall would have stopped the first ball and left
+// the second at rest: half the momentum lost.)
+TEST(BallOntoMagnetRigidMoving, ARiderThatABodyRunsIntoTakesItsShareOfTheMomentum) {
+  SceneDescription scene = weightless_scene("head_on");
+  scene.materials["wood"] = InertMaterial{};
+  scene.bodies.push_back(body("moving", Sphere{0.005}, "wood", {0.0, 0.0, 0.0}, false, 700.0));
+  scene.bodies.back().velocity = {1.0, 0.0, 0.0};
+  scene.bodies.push_back(body("resting", Sphere{0.005}, "wood", {0.0325, 0.0, 0.0}, false, 700.0));
+  scene.simulation.time_step = 0.004;
+  scene.simulation.rigid_substeps = "moving";
+  Simulation sim(scene);
+  const double v0 = 1.0, e = scene.simulation.contact.restitution;
+  int rode = 0;
+  while (sim.time() < 0.06) {
+    sim.step();
+    rode += sim.records().back().whole_step;
+  }
+  ASSERT_GT(rode, 0) << "the resting ball never rode";
+  const double v_back = sim.world().velocity(0).x, v_front = sim.world().velocity(1).x;
+  EXPECT_NEAR(v_back + v_front, v0, 1e-9) << "momentum (per unit mass)";
+  EXPECT_NEAR(v_front, 0.5 * v0 * (1.0 + e), 0.02 * v0);
+  EXPECT_NEAR(v_back, 0.5 * v0 * (1.0 - e), 0.02 * v0);
+}
+
 // With the default ("all") the free ball takes the substeps too: its height
 // leaves the closed form at dt (the test above tells the two apart).
 TEST(BallOntoMagnetRigidMoving, ByDefaultEveryBodyTakesTheSubsteps) {
