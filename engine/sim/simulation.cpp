@@ -37,6 +37,14 @@ Vec3 angular_velocity_between(const Mat3& A, const Mat3& B, double dt) {
   return (angle / (dt * two_sin)) * axis;
 }
 
+// Clears the flag of both bodies of every touching pair in which one is
+// moving: a body touching one that takes the substeps takes them too.
+void clear_touching_moving(const std::vector<std::pair<int, int>>& touching, const std::vector<uint8_t>& moving,
+                           std::vector<uint8_t>& flags) {
+  for (const auto& [a, b] : touching)
+    if (moving[a] || moving[b]) flags[a] = flags[b] = 0;
+}
+
 }  // namespace
 
 BodyPose keyframe_pose(const std::vector<Keyframe>& keys, double t) {
@@ -173,8 +181,7 @@ std::vector<uint8_t> Simulation::bodies_to_hold(double dt) {
   std::vector<uint8_t> held(n, 1);
   for (int b = 0; b < n; ++b)
     if (moving[b]) held[b] = 0;
-  for (const auto& [a, b] : world_->touching())
-    if (moving[a] || moving[b]) held[a] = held[b] = 0;
+  clear_touching_moving(world_->touching(), moving, held);
   for (const auto& [a, k] : world_->touching_kinematic())
     if (moving[a]) held[k] = 0;
   return held;
@@ -201,8 +208,7 @@ std::vector<uint8_t> Simulation::bodies_to_step_whole(double dt, std::vector<uin
   if (!any_moving) return {};
   std::vector<uint8_t> whole(n, 0);
   for (int b = 0; b < n; ++b) whole[b] = substep_motion_[b].free && !moving[b];
-  for (const auto& [a, b] : world_->touching())
-    if (moving[a] || moving[b]) whole[a] = whole[b] = 0;
+  clear_touching_moving(world_->touching(), moving, whole);
   return whole;
 }
 
@@ -222,8 +228,7 @@ void Simulation::step_slow_bodies_whole(double dt, StepRecord& record) {
   note_non_finite(time_ + dt);
   // Its contacts, found at the step's start positions, count too: those
   // bodies_to_step_whole read were the last substep's.
-  for (const auto& [a, b] : world_->touching())
-    if (moving[a] || moving[b]) whole[a] = whole[b] = 0;
+  clear_touching_moving(world_->touching(), moving, whole);
   whole_.assign(n, 0);
   whole_end_.assign(n, {});
   for (int b = 0; b < n && non_finite_body_ < 0; ++b) {
