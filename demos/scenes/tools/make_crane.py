@@ -125,8 +125,9 @@ scene = {
     "solver": {"tolerance": 1e-4},
     # Later substeps relax only around the balls that need them (docs/simulation.md
     # "Substeps"; the same balls held over seeds, docs/benchmarks.md section 4l).
-    # 30 QuickStep sweeps (the default): the same balls held as with 40 over
-    # seeds, the same substeps, T_r -25%; 20 takes more substeps (section 4o).
+    # 30 QuickStep sweeps (the default): over seeds 1-5 the same balls held as
+    # with 40, within 4% of the substeps, T_r -24%; 20 takes 7% more substeps
+    # (docs/benchmarks.md section 4o).
     "simulation": {"time_step": 0.001, "duration": 5.0, "frame_rate": 30, "contact_solver": "quick",
                    "solver_iterations": 30, "magnetic_solve": "moving"},
     "timeline": [
