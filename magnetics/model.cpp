@@ -117,17 +117,8 @@ void build_boundary_correction(MagneticBody& body) {
       for (int a = 0; a < 6; ++a) sum[a] -= v * t[a];
     }
     const Eigen::Matrix3d S = symmetric_matrix(sum), Nbar = symmetric_matrix(nbar), I = Eigen::Matrix3d::Identity();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(I / 3.0 + S - Nbar);
-    Eigen::Vector3d e = eig.eigenvalues();  // ascending
     const double cap = (1.0 - cells.volumes[i] / cells.cell_volume) / 3.0;
-    double cut = 0.0;
-    for (int q = 0; q < 3; ++q)
-      if (e(q) > cap) cut += e(q) - cap, e(q) = cap;
-    for (int q = 2; q >= 0 && cut > 0.0; --q) {
-      const double add = std::min(cap - e(q), cut);
-      e(q) += add, cut -= add;
-    }
-    const Eigen::Matrix3d K = eig.eigenvectors() * e.asDiagonal() * eig.eigenvectors().transpose();
+    const Eigen::Matrix3d K = capped_boundary_correction(I / 3.0 + S - Nbar, cap);
     const Eigen::Matrix3d Pi = gamma * I - K + S, beta = (gamma - 1.0 / 3.0) * I + Nbar;
     const double inv_v = 1.0 / cells.volumes[i];
     auto store = [](const Eigen::Matrix3d& m, double* out, double scale) {
