@@ -4,7 +4,7 @@
 // "Local refinement of the contact zone".)
 //
 // A standalone Galerkin solve of two linear balls (chi, radius R, gap g R, the
-// field H0 along the line), independent of the engine's relaxation: every cell
+// field H0 along the line or across it), independent of the engine's relaxation: every cell
 // is a cube of edge a (h / 2^l) standing for its part of the ball
 // (volume V = w a^3, the volume-share cells of magnetics/cells.h), coupled to
 // every other cell by the cuboid-cuboid tensor N_ij (cuboid_demag_tensor):
@@ -12,7 +12,8 @@
 // cubes centred on their lattice sites within a body and on their centroids
 // between bodies (as the engine), and K_i = sum_{j in body} N_ij w_j - I/3 the
 // boundary correction that gives a uniformly magnetized ball its exact field
-// -M/3 in every cell (exact; --cap gives the engine's). Force on ball 2 at fixed M (the linear bodies' force):
+// -M/3 in every cell (exact; --cap gives the engine's). Force on ball 2 at
+// fixed M (the linear bodies' force):
 //   F_2 = mu0 sum_{i in 1, j in 2} V_i M_i . dN_ij/dd w_j M_j,   d = c_i - c_j.
 // Refinement: a cell whose cube comes within D_0 of the contact point (the
 // ball's point nearest the other ball) is replaced by its 8 sub-cubes of the
@@ -21,8 +22,10 @@
 // on (ball_cells).
 // Against the two-centre series of tests/support/contact_references.h.
 //
-// Usage: contact_refinement [R/h] [--sites] [--cap]
+// Usage: contact_refinement [R/h] [--chi X] [--across] [--sites] [--cap]
 //   R/h: with 2R/h an integer (4, 5.5, 6.5), so that the lattices nest;
+//   --chi: the balls' susceptibility (1000); --across: the field across the
+//   line of centres;
 //   --sites: between bodies too, the cubes on their lattice sites (a
 //   diagnostic: the engine puts them on the centroids);
 //   --cap: the boundary correction as the engine's: its local part capped,
@@ -118,11 +121,13 @@ struct Result {
 };
 
 struct Options {
+  double chi = 1000;      // susceptibility of both balls
+  bool across = false;    // the field across the line of centres (else along it)
   bool at_sites = false;  // cubes on their sites between bodies too (else on their centroids)
   bool cap = false;       // the engine's boundary correction (capped, uniform-mode update)
 };
 
-Result solve(double R, double chi, double h, double gap_over_R, const std::vector<double>& D, double H0,
+Result solve(double R, double chi, double h, double gap_over_R, const std::vector<double>& D, const Vec3& H0,
              const Options& options) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<Cell> cells = ball_cells(R, h, {0, 0, R}, D);
@@ -168,7 +173,8 @@ Result solve(double R, double chi, double h, double gap_over_R, const std::vecto
   // In moments: S = W A (W = diag(V), symmetric), S M = W H0.
   for (int i = 0; i < n; ++i) A.middleRows(3 * i, 3) *= cells[i].volume;
   Eigen::VectorXd rhs = Eigen::VectorXd::Zero(3 * n);
-  for (int i = 0; i < n; ++i) rhs(3 * i + 2) = cells[i].volume * H0;
+  for (int i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) rhs(3 * i + a) = cells[i].volume * H0[a];
   if (options.cap) {
     // The engine's uniform-mode update of each body's own operator S_b
     // (magnetics/model.cpp): S_b' = S_b - (S_b U)(U^T S_b U)^-1 (S_b U)^T + B (U^T B)^-1 B^T,
@@ -215,7 +221,7 @@ Result solve(double R, double chi, double h, double gap_over_R, const std::vecto
 }  // namespace
 
 int main(int argc, char** argv) {
-  const double R = 0.005, chi = 1000, H0 = 1e3;
+  const double R = 0.005;
   double k = 5.5;
   Options options;
   for (int a = 1; a < argc; ++a) {
@@ -224,16 +230,27 @@ int main(int argc, char** argv) {
       options.at_sites = true;
     else if (arg == "--cap")
       options.cap = true;
+    else if (arg == "--across")
+      options.across = true;
+    else if (arg == "--chi" && a + 1 < argc && std::atof(argv[a + 1]) > 0.0)
+      options.chi = std::atof(argv[++a]);
     else if (!arg.empty() && arg[0] != '-' && std::atof(arg.c_str()) >= 2.0)
       k = std::atof(arg.c_str());
     else {
-      std::fprintf(stderr, "contact_refinement: unknown argument '%s'"
-                           " (usage: contact_refinement [R/h] [--sites] [--cap])\n", arg.c_str());
+      std::fprintf(stderr,
+                   "contact_refinement: unknown argument '%s'"
+                   " (usage: contact_refinement [R/h] [--chi X] [--across] [--sites] [--cap])\n",
+                   arg.c_str());
       return 2;
     }
   }
-  const double h = R / k;
-  std::printf("| gap | zone radii D_l / h (to h/2, h/4, h/8) | cells per ball | attraction against exact |"
+  const double h = R / k, chi = options.chi;
+  const Vec3 H0 = options.across ? Vec3{1e3, 0, 0} : Vec3{0, 0, 1e3};
+  std::printf("R/h %g, chi %g, the field %s the line of centres, cubes between bodies on their %s,"
+              " %s boundary correction\n\n",
+              k, chi, options.across ? "across" : "along", options.at_sites ? "sites" : "centroids",
+              options.cap ? "the engine's" : "the exact");
+  std::printf("| gap | zone radii D_l / h (to h/2, h/4, h/8) | cells per ball | force against exact |"
               " solve (s) |\n");
   std::printf("|---|---|---|---|---|\n");
   // Per row the zone radius of each refinement level, in units of h.
@@ -242,7 +259,7 @@ int main(int argc, char** argv) {
                                                   {1.5, 1.0, 0.25}, {1.5, 1.0, 0.5}};
   for (double g : {0.05, 0.1, 0.5}) {
     const auto ref = reference::two_linear_spheres_in_uniform_field(R, chi, R, chi, {0, 0, 0},
-                                                                    {0, 0, (2.0 + g) * R}, {0, 0, H0});
+                                                                    {0, 0, (2.0 + g) * R}, H0);
     for (const std::vector<double>& zone : zones) {
       std::vector<double> D;
       std::string radii = zone.empty() ? "none" : "";
