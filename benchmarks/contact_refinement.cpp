@@ -57,6 +57,7 @@ struct Cell {
   double edge;    // a, m
   double volume;  // V = w a^3, m^3
   int body;
+  double share() const { return volume / (edge * edge * edge); }  // w: the cube's share inside the ball
 };
 
 using Index = std::array<int, 3>;
@@ -127,9 +128,10 @@ struct Options {
   bool cap = false;       // the engine's boundary correction (capped, uniform-mode update)
 };
 
-Result solve(double R, double chi, double h, double gap_over_R, const std::vector<double>& D, const Vec3& H0,
+Result solve(double R, double h, double gap_over_R, const std::vector<double>& D, const Vec3& H0,
              const Options& options) {
   const auto t0 = std::chrono::steady_clock::now();
+  const double chi = options.chi;
   std::vector<Cell> cells = ball_cells(R, h, {0, 0, R}, D);
   const int per_ball = static_cast<int>(cells.size());
   const double c2 = (2.0 + gap_over_R) * R;
@@ -159,12 +161,12 @@ Result solve(double R, double chi, double h, double gap_over_R, const std::vecto
       double t[6];
       cuboid_demag_tensor(ha, hb, dd, t);
       const Eigen::Matrix3d N = symmetric_matrix(t);
-      const double w = b.volume / (b.edge * b.edge * b.edge);
+      const double w = b.share();
       A.block<3, 3>(3 * i, 3 * j) = w * N;
       if (a.body == b.body) sum += w * N;
     }
     // Own cube (w_i I/3) minus K_i = sum_{j in body} N_ij w_j - I/3.
-    const double wi = a.volume / (a.edge * a.edge * a.edge);
+    const double wi = a.share();
     Eigen::Matrix3d K = sum + (wi - 1.0) / 3.0 * Eigen::Matrix3d::Identity();
     if (options.cap) K = capped_boundary_correction(K, (1.0 - wi) / 3.0);  // the engine's local part
     A.block<3, 3>(3 * i, 3 * i) = wi / 3.0 * Eigen::Matrix3d::Identity() - K;
@@ -210,7 +212,7 @@ Result solve(double R, double chi, double h, double gap_over_R, const std::vecto
       double t[6], dt[3][6];
       cuboid_demag_tensor(ha, hb, dd, t, dt);
       const Eigen::Matrix3d G = symmetric_matrix(dt[2]);  // dN/dd_z
-      const double w = b.volume / (b.edge * b.edge * b.edge);
+      const double w = b.share();
       fz += kMu0 * a.volume * Mi.dot(G * (w * M.segment<3>(3 * j)));
     }
   }
@@ -269,7 +271,7 @@ int main(int argc, char** argv) {
         std::snprintf(b, sizeof b, "%s%g", radii.empty() ? "" : ", ", d);
         radii += b;
       }
-      const Result r = solve(R, chi, h, g, D, H0, options);
+      const Result r = solve(R, h, g, D, H0, options);
       std::printf("| %g R | %s | %d | %+.2f%% | %.1f |\n", g, radii.c_str(), r.cells_per_ball,
                   100.0 * (std::abs(r.force_z) - std::abs(ref.force_on_2.z)) / std::abs(ref.force_on_2.z),
                   r.seconds);
