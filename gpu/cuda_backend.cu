@@ -157,14 +157,19 @@ class CudaBackend final : public MagneticBackend {
   void begin_step(const MagneticModel& model, const MagneticState& state) override {
     select(device_);
     CallTimer timer(events_, stream(), stats_.begin_step);
-    // Bodies of graded cells carry per-pair tensors (MagneticBody::
-    // pair_tensors) that this backend does not sum: refuse them rather than
-    // give their cells no intra-body field (docs/model.md "Graded cells").
-    for (const MagneticBody& body : model.bodies())
+    // Bodies of graded cells or refined zones carry per-pair tensors
+    // (MagneticBody::pair_tensors) that this backend does not sum: refuse them
+    // rather than give their cells no intra-body field (docs/model.md "Graded
+    // cells", "Refined contact zones").
+    for (const MagneticBody& body : model.bodies()) {
       if (body.cells.graded && body.responsive())
         throw std::invalid_argument("CUDA backend: body \"" + body.name +
                                     "\" has graded cells, which only the CPU backend supports "
                                     "(MagneticModel::set_graded_cells(false) gives it a uniform lattice)");
+      if (body.cells.refined && body.responsive())
+        throw std::invalid_argument("CUDA backend: body \"" + body.name +
+                                    "\" has refined zones, which only the CPU backend supports");
+    }
     for (const MagneticBody& body : model.bodies())
       if (!body.bh_curve.empty())
         throw std::invalid_argument("CUDA backend: body \"" + body.name +

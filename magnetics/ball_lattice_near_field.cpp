@@ -620,7 +620,8 @@ class BallLatticeNearField final : public NearFieldTerm {
     cached_bodies_ = model.body_count();
     for (int bi = 0; bi < model.body_count(); ++bi) {
       const MagneticBody& body = model.body(bi);
-      if (body.inert() || body.cells.spacing <= 0.0 || body.cell_count() < 3 || body.cells.graded) continue;
+      if (body.inert() || body.cells.spacing <= 0.0 || body.cell_count() < 3 || body.cells.mixed_sizes())
+        continue;
       LatticeBody lb;
       lb.body = bi;
       lb.h = body.cells.spacing;

@@ -21,12 +21,14 @@ struct BodyResponseFactor {
 bool takes_body_response(const MagneticBody& body) {
   const int n = body.cell_count();
   return body.kind == CellKind::soft && body.bh_curve.empty() && body.soft.H_K == 0.0 && !body.cells.graded &&
-         !body.offset_tensors.empty() && n >= kMinResponseCells && n <= kMaxResponseCells &&
+         (!body.offset_tensors.empty() || body.cells.refined) && n >= kMinResponseCells &&
+         n <= kMaxResponseCells &&
          body.soft.gamma_D <= 1.0 / 3.0 + 1e-2;
 }
 
 // S = I - W^1/2 K W^1/2 / gamma_D, K_ij the field at cell i per unit moment
-// at cell j inside the body: the offset tensors T(l_i - l_j) (i != j), the
+// at cell j inside the body: the offset tensors T(l_i - l_j) (i != j; a body
+// of refined zones: its pair tensors T_ij), the
 // boundary correction's self tensors S_i (i = j) and its uniform-mode terms
 // Pi_i G_Pi Pi_j - beta_i G_beta beta_j (magnetics/model.cpp
 // build_boundary_correction). So J_ij = K_ij V_j / gamma_D.
@@ -44,7 +46,11 @@ std::shared_ptr<const BodyResponseFactor> build_body_response(const MagneticBody
   for (int j = 0; j < n; ++j) {
     for (int i = j; i < n; ++i) {  // the lower triangle: all LLT reads
       Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
-      if (i != j) K = symmetric_matrix(&body.offset_tensors[6u * body.offset_index(cells.lattice_index[i], cells.lattice_index[j])]);
+      if (i != j)
+        K = symmetric_matrix(
+            cells.refined
+                ? &body.pair_tensors[6u * (static_cast<size_t>(i) * n + j)]
+                : &body.offset_tensors[6u * body.offset_index(cells.lattice_index[i], cells.lattice_index[j])]);
       if (boundary) {
         if (i == j) K += symmetric_matrix(&body.self_tensors[6u * i]);
         K += symmetric_matrix(&body.uniform_tensors[12u * i]) * G_pi * symmetric_matrix(&body.uniform_tensors[12u * j]) -

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <stdexcept>
+#include <string>
 
 #include "magnetics/cell_field.h"
 #include "magnetics/constants.h"
@@ -343,42 +344,65 @@ CellSet centre_inside_cells(const Shape& shape, double cell_size) {
   return cells;
 }
 
+// The part of the cube of edge a centred on site inside the shape, as a
+// volume-share cell: its volume, centroid and contact radius (the inscribed
+// radius about the centroid, clamped to [a/4, a/2]); volume 0 for a cube
+// with no more than kMinCellShare of its volume inside. whole: the cube lies
+// inside (volume a^3, at the site).
+struct ShareCell {
+  double volume = 0.0;
+  Vec3 centroid;
+  double contact = 0.0;
+  bool whole = true;
+};
+
+ShareCell share_cell(const Shape& shape, const Vec3& site, double a) {
+  const double a3 = a * a * a;
+  const Vec3 lo = site - Vec3{0.5 * a, 0.5 * a, 0.5 * a}, hi = site + Vec3{0.5 * a, 0.5 * a, 0.5 * a};
+  if (box_inside_shape(shape, lo, hi, 1e-9 * a)) return {a3, site, 0.5 * a, true};
+  const Moments m = box_in_shape(shape, lo, hi);
+  if (!(m.v > kMinCellShare * a3)) return {};
+  const Vec3 p = Vec3{m.x, m.y, m.z} / m.v;
+  double in_region = 0.5 * a;
+  for (int k = 0; k < 3; ++k) in_region = std::min({in_region, p[k] - lo[k], hi[k] - p[k]});
+  return {m.v, p, std::clamp(std::min(in_region, depth_inside(shape, p)), 0.25 * a, 0.5 * a), false};
+}
+
+// Lattice points per axis of the volume-share cells at h: ceil(extent / h),
+// so that the cubes cover the body; and the site of point (i, j, k).
+std::array<int, 3> volume_share_extent(const Shape& shape, double h) {
+  const Vec3 half = shape_half_extents(shape);
+  std::array<int, 3> n{};
+  for (int a = 0; a < 3; ++a) n[a] = static_cast<int>(std::ceil(2.0 * half[a] / h - 1e-9));
+  return n;
+}
+
+Vec3 lattice_site(const std::array<int, 3>& n, double h, int i, int j, int k) {
+  return {(i - 0.5 * (n[0] - 1)) * h, (j - 0.5 * (n[1] - 1)) * h, (k - 0.5 * (n[2] - 1)) * h};
+}
+
 // Volume-share cells: per axis ceil(extent / h) points, so that the cubes
 // cover the body; every cube with more than kMinCellShare of its volume inside
 // is a cell standing for its part of the body, at that part's centroid.
 CellSet volume_share_cells(const Shape& shape, double h) {
   CellSet cells;
-  const Vec3 half = shape_half_extents(shape);
-  const double h3 = h * h * h, tol = 1e-9 * h;
-  std::array<int, 3> n{};
-  for (int a = 0; a < 3; ++a) n[a] = static_cast<int>(std::ceil(2.0 * half[a] / h - 1e-9));
+  const std::array<int, 3> n = volume_share_extent(shape, h);
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
       for (int i = 0; i < n[0]; ++i) {
-        const Vec3 site{(i - 0.5 * (n[0] - 1)) * h, (j - 0.5 * (n[1] - 1)) * h, (k - 0.5 * (n[2] - 1)) * h};
-        const Vec3 lo = site - Vec3{0.5 * h, 0.5 * h, 0.5 * h}, hi = site + Vec3{0.5 * h, 0.5 * h, 0.5 * h};
-        Vec3 p = site;
-        double v = h3, contact = 0.5 * h;
-        if (!box_inside_shape(shape, lo, hi, tol)) {
-          const Moments m = box_in_shape(shape, lo, hi);
-          if (!(m.v > kMinCellShare * h3)) continue;
-          v = m.v;
-          p = Vec3{m.x, m.y, m.z} / m.v;
-          double in_region = 0.5 * h;
-          for (int a = 0; a < 3; ++a) in_region = std::min({in_region, p[a] - lo[a], hi[a] - p[a]});
-          contact = std::clamp(std::min(in_region, depth_inside(shape, p)), 0.25 * h, 0.5 * h);
-          cells.whole_cells = false;
-        }
-        cells.local_positions.push_back(p);
+        const ShareCell c = share_cell(shape, lattice_site(n, h, i, j, k), h);
+        if (c.volume == 0.0) continue;
+        if (!c.whole) cells.whole_cells = false;
+        cells.local_positions.push_back(c.centroid);
         cells.lattice_index.push_back({i, j, k});
-        cells.volumes.push_back(v);
-        cells.contact_radii.push_back(contact);
+        cells.volumes.push_back(c.volume);
+        cells.contact_radii.push_back(c.contact);
       }
   cells.lattice_extent = n;
   cells.spacing = h;
-  cells.cell_volume = h3;
+  cells.cell_volume = h * h * h;
   cells.contact_radius = 0.5 * h;
-  cells.cell_radius = std::cbrt(3.0 * h3 / (4.0 * kPi));
+  cells.cell_radius = std::cbrt(3.0 * cells.cell_volume / (4.0 * kPi));
   return cells;
 }
 
@@ -460,20 +484,84 @@ CellSet make_cells(const Shape& shape, double cell_size) {
                                               : centre_inside_cells(shape, cell_size);
 }
 
+std::vector<double> default_refinement_radii(double cell_size) {
+  return {1.25 * cell_size, 0.75 * cell_size, 0.25 * cell_size};
+}
+
+CellSet make_refined_cells(const Shape& shape, double cell_size, const std::vector<RefinedZone>& zones) {
+  if (!uses_volume_shares(shape, cell_size))
+    throw std::invalid_argument(
+        "refined zones need a curved body (ball or cylinder) at least 2 cells across (volume-share cells)");
+  for (const RefinedZone& z : zones) {
+    if (!is_finite(z.point)) throw std::invalid_argument("refined zone: the point must be finite");
+    if (z.radii.size() > kMaxRefinementLevels)
+      throw std::invalid_argument("refined zone: at most " + std::to_string(kMaxRefinementLevels) +
+                                  " levels");
+    for (double r : z.radii)
+      if (!(r >= 0.0) || !std::isfinite(r))
+        throw std::invalid_argument("refined zone: the radii must be finite and not negative");
+  }
+  const double h = cell_size;
+  const std::array<int, 3> n = volume_share_extent(shape, h);
+  CellSet cells;
+  // A cube of edge a at level l is split when it comes within radii[l] of a zone's point.
+  auto split = [&](const Vec3& site, double a, size_t level) {
+    for (const RefinedZone& z : zones) {
+      if (level >= z.radii.size()) continue;
+      double d2 = 0.0;
+      for (int k = 0; k < 3; ++k) {
+        const double e = std::max(0.0, std::fabs(z.point[k] - site[k]) - 0.5 * a);
+        d2 += e * e;
+      }
+      // Ties (a cube exactly D_l away: symmetric scenes) are not refined.
+      if (d2 < z.radii[level] * z.radii[level] * (1.0 - 1e-9)) return true;
+    }
+    return false;
+  };
+  // Depth first, the 8 sub-cubes of a split cube in x-fastest order in its
+  // place: the order depends only on the geometry.
+  auto emit = [&](auto&& self, const Vec3& site, double a, size_t level,
+                  const std::array<int, 3>& index) -> void {
+    if (split(site, a, level)) {
+      for (int dz = 0; dz < 2; ++dz)
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx)
+            self(self, site + 0.25 * a * Vec3{2.0 * dx - 1.0, 2.0 * dy - 1.0, 2.0 * dz - 1.0}, 0.5 * a,
+                 level + 1, {2 * index[0] + dx, 2 * index[1] + dy, 2 * index[2] + dz});
+      return;
+    }
+    const ShareCell c = share_cell(shape, site, a);
+    if (c.volume == 0.0) return;
+    if (cells.size() >= kMaxRefinedCells)
+      throw std::invalid_argument("refined zones give more than " + std::to_string(kMaxRefinedCells) +
+                                  " cells (their intra-body tensors take 48 bytes per pair of cells)");
+    cells.local_positions.push_back(c.centroid);
+    cells.lattice_index.push_back(index);
+    cells.volumes.push_back(c.volume);
+    cells.contact_radii.push_back(c.contact);
+    cells.cube_centres.push_back(site);
+    cells.half_extents.push_back({0.5 * a, 0.5 * a, 0.5 * a});
+  };
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) emit(emit, lattice_site(n, h, i, j, k), h, 0, {i, j, k});
+  cells.lattice_extent = n;
+  cells.spacing = h;
+  cells.cell_volume = h * h * h;
+  cells.contact_radius = 0.5 * h;
+  cells.cell_radius = std::cbrt(3.0 * cells.cell_volume / (4.0 * kPi));
+  cells.whole_cells = false;
+  cells.refined = true;
+  return cells;
+}
+
 void uniform_demag_over_cell(const Shape& shape, const CellSet& cells, int i, double n[6]) {
   for (int a = 0; a < 6; ++a) n[a] = 0.0;
   static const double g3x[3] = {-0.774596669241483377035853079956, 0.0, 0.774596669241483377035853079956};
   static const double g3w[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};  // weights / 2 (mean over [-1, 1])
   // The cell's region, as make_cells: its cube (clipped to the body below).
-  const double h = cells.spacing;
-  const auto& l = cells.lattice_index[i];
-  const auto& ne = cells.lattice_extent;
-  Vec3 rlo, rhi;
-  for (int a = 0; a < 3; ++a) {
-    const double site = (l[a] - 0.5 * (ne[a] - 1)) * h;
-    rlo[a] = site - 0.5 * h;
-    rhi[a] = site + 0.5 * h;
-  }
+  const Vec3 site = cells.cube_centre(i), half = cells.cube_half(i);
+  const Vec3 rlo = site - half, rhi = site + half;
   std::visit(Overloaded{
                  [&](const Sphere&) { n[0] = n[3] = n[5] = 1.0 / 3.0; },
                  [&](const Box&) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <vector>
 
 #include "magnetics/shape.h"
@@ -54,8 +55,32 @@ struct CellSet {
   bool graded = false;
   std::vector<Vec3> half_extents;
   std::array<std::vector<double>, 3> faces;  // graded: the n_a + 1 face positions per axis, m
+  // Refined zones (make_refined_cells): volume-share cells of a curved body
+  // whose cubes have edges h / 2^l, finer near given points. Per cell the
+  // centre of its cube (body frame; the centroid of its part of the body is
+  // local_positions) and its half edges (half_extents); lattice_index is the
+  // cube's index on the lattice at its own edge, nested in the one at h.
+  // whole_cells is false; the body's intra-body tensors are per pair
+  // (MagneticBody::pair_tensors).
+  bool refined = false;
+  std::vector<Vec3> cube_centres;
 
   int size() const { return static_cast<int>(local_positions.size()); }
+  // Cells of their own sizes (graded or refined): per-pair intra-body
+  // tensors, and no lattice near field between bodies.
+  bool mixed_sizes() const { return graded || refined; }
+  // The cube (cuboid) cell i stands for: its centre in the body frame and its
+  // half edges.
+  Vec3 cube_centre(int i) const {
+    if (refined) return cube_centres[i];
+    if (graded) return local_positions[i];
+    Vec3 site;
+    for (int a = 0; a < 3; ++a) site[a] = (lattice_index[i][a] - 0.5 * (lattice_extent[a] - 1)) * spacing;
+    return site;
+  }
+  Vec3 cube_half(int i) const {
+    return half_extents.empty() ? Vec3{0.5 * spacing, 0.5 * spacing, 0.5 * spacing} : half_extents[i];
+  }
 };
 
 // Cells of a shape on a lattice of spacing h = cell_size (docs/model.md
@@ -80,6 +105,32 @@ CellSet make_cells(const Shape& shape, double cell_size);
 // standing for its volume at its centre. For uses_graded_cells shapes only
 // (std::invalid_argument otherwise).
 CellSet make_graded_box_cells(const Shape& shape, double cell_size);
+
+// A zone of a body's lattice refined towards a point (docs/model.md "Refined
+// contact zones"): a cell whose cube (edge h / 2^l) comes within radii[l] of
+// the point is replaced by the 8 cubes of edge h / 2^(l+1) that tile it, for
+// l < radii.size() (at most kMaxRefinementLevels).
+struct RefinedZone {
+  Vec3 point;                 // body frame, m
+  std::vector<double> radii;  // D_l, m
+};
+
+inline constexpr size_t kMaxRefinementLevels = 4;
+// A body of refined zones may have at most this many cells: its per-pair
+// tensors take 48 n^2 bytes (770 MB at 4000 cells).
+inline constexpr int kMaxRefinedCells = 4000;
+
+// The radii chosen for two balls near contact (docs/model.md "Refined contact
+// zones", measured in docs/validation.md section 5): 1.25 h, 0.75 h, h / 4,
+// i.e. cubes of h / 8 at the point.
+std::vector<double> default_refinement_radii(double cell_size);
+
+// The volume-share cells of make_cells at cell_size, refined in the zones
+// (CellSet::refined). For shapes that uses_volume_shares accepts (curved
+// bodies at least kMinVolumeShareExtent cells across); std::invalid_argument
+// otherwise, or for a non-finite point, negative or non-finite radii, more
+// than kMaxRefinementLevels levels, or more than kMaxRefinedCells cells.
+CellSet make_refined_cells(const Shape& shape, double cell_size, const std::vector<RefinedZone>& zones);
 
 // True when a responsive body of this shape gets graded cells: a box at
 // least kMinGradedExtent cells along every axis with at most kMaxGradedCells

@@ -136,8 +136,8 @@ class CpuBackend final : public MagneticBackend {
                                sum_field(resp_.sources(), end, n, resp_.x[i], resp_.y[i], resp_.z[i], resp_.radius[i]);
       // Intra-body: cached tensors of the body, in the body frame.
       const MagneticBody& body = model.body(b);
-      if (body.cells.graded) {
-        // Graded cells: per-pair tensors, the diagonal included (model.h).
+      if (!body.pair_tensors.empty()) {
+        // Graded cells or refined zones: per-pair tensors, the diagonal included (model.h).
         const size_t row = static_cast<size_t>(resp.cell[i] - body.first_cell) * body.cell_count();
         Vec3 hb;
         for (int j = begin; j < end; ++j)

@@ -34,6 +34,10 @@ std::vector<ProbeCell> probe_cells(const MagneticModel& model, const MagneticSta
     for (int i = 0; i < body.cell_count(); ++i) {
       const int c = body.first_cell + i;
       ProbeCell cell = base;
+      if (body.cells.refined) {  // its own cube (edge h / 2^l), at its point as on the lattice
+        cell.half = body.cells.cube_half(i);
+        cell.volume = 8.0 * cell.half.x * cell.half.y * cell.half.z;
+      }
       cell.position = state.cell_position[c];
       cell.moment = body.cells.volumes[i] * state.magnetization[c];
       cells.push_back(cell);

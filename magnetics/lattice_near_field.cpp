@@ -323,10 +323,11 @@ class LatticeNearField final : public NearFieldTerm {
     std::vector<int> eligible;
     for (int b = 0; b < model.body_count(); ++b) {
       const MagneticBody& body = model.body(b);
-      // Graded bodies (CellSet::graded) are not cubes on one lattice: they keep
-      // the point dipoles between bodies (docs/model.md "Graded cells").
+      // Graded bodies and refined zones (CellSet::mixed_sizes) are not cubes on
+      // one lattice: they keep the point dipoles between bodies (docs/model.md
+      // "Graded cells", "Refined contact zones").
       if (body.inert() || !state.active[b] || body.cells.spacing <= 0.0 || body.cell_count() < 3 ||
-          body.cells.graded)
+          body.cells.mixed_sizes())
         continue;
       LatticeBody& lb = bodies_[b];
       const double h = body.cells.spacing;

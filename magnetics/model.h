@@ -51,6 +51,10 @@ struct MagneticBody {
   // V_j N_ji), and on the diagonal T_ii = -(N_ii - I / 3) / V_i: the
   // cell's own demagnetising tensor beyond the cube's I / 3 that the local
   // relaxation (gamma_D) already holds. offset_tensors is empty then.
+  // Bodies of refined zones (CellSet::refined) too, with their cubes: T_ij =
+  // -N_ij / a_j^3 (a_j the edge of cell j's cube, N_ij of the two cubes at
+  // their cube centres) and T_ii = 0 (magnetics/model.cpp
+  // build_refined_pair_tensors).
   std::vector<double> pair_tensors;
   // Boundary correction of the intra-body field of a responsive body with
   // partial cells (docs/model.md "Cells"; magnetics/state.h add_boundary_field),
@@ -158,8 +162,13 @@ class MagneticModel {
   // one cell at the centre. Throws std::invalid_argument on a bad shape or
   // material, or a lattice beyond kMaxBodyLatticePoints (validate_body_lattice,
   // checked before any cell is made).
-  int add_body(const std::string& name, const Shape& shape, const Material& material,
-               double cell_size);
+  // zones: refined zones of the body's lattice (make_refined_cells, docs/model.md
+  // "Refined contact zones"), in the body frame; for curved bodies of
+  // volume-share cells with the cell_average tensor (std::invalid_argument
+  // otherwise, naming the body). Such a body takes no lattice or ball-lattice
+  // near field and no block preconditioner, and only the CPU backend runs it.
+  int add_body(const std::string& name, const Shape& shape, const Material& material, double cell_size,
+               const std::vector<RefinedZone>& zones = {});
 
   // Attaches a current source to body `body` (body frame). Throws
   // std::invalid_argument on a bad index or geometry (coil_source_error).

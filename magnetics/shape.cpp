@@ -1,5 +1,6 @@
 #include "magnetics/shape.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "magnetics/constants.h"
@@ -41,6 +42,25 @@ bool shape_contains(const Shape& shape, const Vec3& p, double tol) {
           },
       },
       shape);
+}
+
+Vec3 closest_point_in_shape(const Shape& shape, const Vec3& p) {
+  return std::visit(Overloaded{
+                        [&](const Sphere& s) {
+                          const double r = norm(p);
+                          return r <= s.radius ? p : (s.radius / r) * p;
+                        },
+                        [&](const Box& b) {
+                          const Vec3 e = 0.5 * b.size;
+                          return Vec3{std::clamp(p.x, -e.x, e.x), std::clamp(p.y, -e.y, e.y),
+                                      std::clamp(p.z, -e.z, e.z)};
+                        },
+                        [&](const Cylinder& c) {
+                          const double rho = std::hypot(p.x, p.y), s = rho <= c.radius ? 1.0 : c.radius / rho;
+                          return Vec3{s * p.x, s * p.y, std::clamp(p.z, -0.5 * c.length, 0.5 * c.length)};
+                        },
+                    },
+                    shape);
 }
 
 std::string validate_shape(const Shape& shape) {

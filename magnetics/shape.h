@@ -37,6 +37,9 @@ double shape_volume(const Shape& shape);
 Vec3 shape_half_extents(const Shape& shape);
 // True when the body-frame point lies inside the shape (boundary included up to tol).
 bool shape_contains(const Shape& shape, const Vec3& local, double tol = 0.0);
+// The point of the shape (boundary included) nearest the body-frame point p:
+// p itself when inside.
+Vec3 closest_point_in_shape(const Shape& shape, const Vec3& p);
 // Empty when valid, else a message naming the offending key.
 std::string validate_shape(const Shape& shape);
 const char* shape_kind(const Shape& shape);

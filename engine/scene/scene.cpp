@@ -939,6 +939,8 @@ const KeyTable<SolverSettings> kSolverKeys = {
      .doc = {"bool", "", "`true`"}},
     {.name = "graded_cells", .check = Check::boolean, .slot = SLOT(graded_cells),
      .doc = {"bool", "", "`false`"}},
+    {.name = "contact_refinement", .check = Check::boolean, .slot = SLOT(contact_refinement),
+     .doc = {"bool", "", "`false`"}},
     {.name = "backend", .check = Check::choice, .slot = SLOT(backend), .words = {"cpu", "cuda", "auto"},
      .late = true, .doc = {"string", "", "`\"auto\"`"}},
     {.name = "threads", .check = Check::integer, .slot = SLOT(threads),

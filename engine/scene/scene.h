@@ -71,6 +71,10 @@ struct SolverSettings {
   // Graded cells for responsive boxes (MagneticModel::set_graded_cells,
   // docs/model.md "Graded cells"); CPU backend only ("auto" then picks it).
   bool graded_cells = false;
+  // Refined contact zones for lattice balls near other bodies at the scene's
+  // poses (engine/sim/magnetic_system.h scene_contact_zones, docs/model.md
+  // "Refined contact zones"); CPU backend only.
+  bool contact_refinement = false;
 };
 
 struct ContactSettings {

@@ -16,6 +16,49 @@ BodyPose scene_pose(const BodyDescription& body) {
   return pose;
 }
 
+namespace {
+
+bool responsive_material(const Material& material) {
+  if (std::holds_alternative<SoftMaterial>(material)) return true;
+  const auto* permanent = std::get_if<PermanentMaterial>(&material);
+  return permanent && permanent->recoil_susceptibility > 0.0;
+}
+
+}  // namespace
+
+std::vector<RefinedZone> scene_contact_zones(const SceneDescription& scene, int b) {
+  if (!scene.solver.contact_refinement) return {};
+  const BodyDescription& body = scene.bodies[b];
+  const auto* ball = std::get_if<Sphere>(&body.shape);
+  const auto material = scene.materials.find(body.material);
+  const double h = scene.body_cell_size(b);
+  if (!ball || material == scene.materials.end() || !responsive_material(material->second) ||
+      !uses_volume_shares(body.shape, h))
+    return {};
+  const BodyPose pose = scene_pose(body);
+  std::vector<RefinedZone> zones;
+  for (size_t o = 0; o < scene.bodies.size(); ++o) {
+    const BodyDescription& other = scene.bodies[o];
+    const auto other_material = scene.materials.find(other.material);
+    if (static_cast<int>(o) == b || other_material == scene.materials.end() ||
+        is_inert(other_material->second))
+      continue;
+    // The other body's point nearest this ball's centre, and this ball's
+    // surface point towards it.
+    const BodyPose other_pose = scene_pose(other);
+    const Vec3 nearest =
+        other_pose.position +
+        other_pose.rotation * closest_point_in_shape(other.shape, other_pose.rotation.transpose_times(
+                                                                      pose.position - other_pose.position));
+    const Vec3 towards = nearest - pose.position;
+    const double distance = norm(towards);
+    if (!(distance > 0.0) || distance - ball->radius > kContactRefinementGap * ball->radius) continue;
+    zones.push_back(
+        {pose.rotation.transpose_times((ball->radius / distance) * towards), default_refinement_radii(h)});
+  }
+  return zones;
+}
+
 MagneticSystem build_magnetic_system(const SceneDescription& scene) {
   MagneticSystem ms;
   ms.model.set_graded_cells(scene.solver.graded_cells);
@@ -26,8 +69,9 @@ MagneticSystem build_magnetic_system(const SceneDescription& scene) {
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "].material",
                        "unknown material \"" + body.material + "\"");
     try {
-      const int index =
-          ms.model.add_body(body.name, body.shape, material->second, scene.body_cell_size(static_cast<int>(b)));
+      const int index = ms.model.add_body(body.name, body.shape, material->second,
+                                          scene.body_cell_size(static_cast<int>(b)),
+                                          scene_contact_zones(scene, static_cast<int>(b)));
       for (const CoilSource& coil : body.coils) ms.model.add_coil(index, coil);
     } catch (const std::invalid_argument& e) {
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
@@ -70,7 +114,15 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene) {
     const Material& material = scene.materials.at(body.material);
     if (is_inert(material)) continue;
     const double h = scene.body_cell_size(static_cast<int>(b));
-    const double cells = h > 0.0 ? static_cast<double>(make_cells(body.shape, h).size()) : 1.0;
+    const std::vector<RefinedZone> zones = scene_contact_zones(scene, static_cast<int>(b));
+    double cells = 1.0;
+    try {
+      if (h > 0.0)
+        cells = static_cast<double>(
+            (zones.empty() ? make_cells(body.shape, h) : make_refined_cells(body.shape, h, zones)).size());
+    } catch (const std::invalid_argument& e) {  // refined zones beyond kMaxRefinedCells
+      throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
+    }
     const auto* permanent = std::get_if<PermanentMaterial>(&material);
     counts.magnetized += cells;
     if (!permanent || permanent->recoil_susceptibility > 0.0) counts.responsive += cells;
@@ -80,6 +132,9 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene) {
 
 std::string cpu_only_feature(const SceneDescription& scene) {
   if (scene.solver.graded_cells) return "graded cells (solver.graded_cells)";
+  for (size_t b = 0; b < scene.bodies.size(); ++b)
+    if (!scene_contact_zones(scene, static_cast<int>(b)).empty())
+      return "refined contact zones (solver.contact_refinement)";
   for (const auto& [name, material] : scene.materials)
     if (const auto* soft = std::get_if<SoftMaterial>(&material); soft && !soft->bh_curve.empty())
       return "a B-H curve (materials." + name + ".bh_curve)";

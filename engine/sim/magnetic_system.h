@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "engine/scene/scene.h"
 #include "magnetics/backend.h"
@@ -42,6 +43,16 @@ struct SceneCellCounts {
 };
 SceneCellCounts count_scene_cells(const SceneDescription& scene);
 
+// The refined contact zones of body b (docs/model.md "Refined contact
+// zones"), with solver.contact_refinement: a lattice ball of a responsive
+// material (soft, or a magnet with recoil) gets one zone, with
+// default_refinement_radii, at its surface point nearest each other
+// magnetized or soft body whose nearest point lies within
+// kContactRefinementGap radii of its surface, at the scene's poses (the
+// zones stay where they are in the body frame). Empty otherwise.
+std::vector<RefinedZone> scene_contact_zones(const SceneDescription& scene, int b);
+inline constexpr double kContactRefinementGap = 0.5;
+
 // The body's pose in the scene description.
 BodyPose scene_pose(const BodyDescription& body);
 
@@ -54,7 +65,8 @@ std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threa
                                               std::string* notice, const std::string& cpu_only = "");
 
 // "" or the first of the scene's CPU-only features, as a user reads it: graded
-// cells (solver.graded_cells), a B-H curve (materials.NAME.bh_curve).
+// cells (solver.graded_cells), refined contact zones (solver.contact_refinement
+// with a zone), a B-H curve (materials.NAME.bh_curve).
 std::string cpu_only_feature(const SceneDescription& scene);
 
 }  // namespace odemag

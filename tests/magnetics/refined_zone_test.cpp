@@ -1,0 +1,220 @@
+// Refined contact zones (docs/model.md "Refined contact zones"): a lattice
+// ball whose cells near a point are split into cubes of h/2, h/4, h/8
+// (make_refined_cells, MagneticModel::add_body with zones). Checked against
+// independent references written in the tests: the ball's volume, the
+// continuum sphere's moment in a uniform field, and the two-centre series of
+// two linear spheres in a uniform field (tests/support/contact_references.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <stdexcept>
+#include <vector>
+
+#include "magnetics/backend.h"
+#include "magnetics/cells.h"
+#include "magnetics/constants.h"
+#include "magnetics/model.h"
+#include "magnetics/relax.h"
+#include "magnetics/state.h"
+#include "tests/support/contact_references.h"
+
+namespace odemag {
+namespace {
+
+constexpr double kR = 0.005;
+
+SoftMaterial linear_soft(double chi) {
+  SoftMaterial mat;
+  mat.saturation = 1e12;  // linear at these fields
+  mat.susceptibility = chi;
+  return mat;
+}
+
+// 1. Geometry: the cells' volumes add up to the ball; without zones the cells
+// are make_cells'; the cubes nest (each cube's centre lies on the lattice of
+// its own edge), do not overlap (their cube volumes add up to no more than
+// the lattice's cubes), and the cells at the point are h/8 cubes.
+TEST(RefinedZone, CellsTileTheBallOnNestedLattices) {
+  const double h = kR / 4.0;
+  const Sphere ball{kR};
+  const CellSet plain = make_cells(ball, h);
+  const CellSet none = make_refined_cells(ball, h, {});
+  ASSERT_EQ(none.size(), plain.size());
+  for (int i = 0; i < plain.size(); ++i) {
+    EXPECT_EQ(none.volumes[i], plain.volumes[i]);
+    EXPECT_EQ(norm(none.local_positions[i] - plain.local_positions[i]), 0.0);
+    EXPECT_EQ(norm(none.cube_centre(i) - plain.cube_centre(i)), 0.0);
+  }
+  const Vec3 P{0, 0, kR};
+  const CellSet cells = make_refined_cells(ball, h, {{P, default_refinement_radii(h)}});
+  EXPECT_TRUE(cells.refined);
+  EXPECT_TRUE(cells.mixed_sizes());
+  EXPECT_LE(cells.size(), 1000);
+  EXPECT_GT(cells.size(), plain.size());
+  double volume = 0.0, cubes = 0.0;
+  std::set<double> edges;
+  for (int i = 0; i < cells.size(); ++i) {
+    volume += cells.volumes[i];
+    const Vec3 half = cells.cube_half(i);
+    const double a = 2.0 * half.x;
+    cubes += a * a * a;
+    edges.insert(a);
+    EXPECT_LE(cells.volumes[i], a * a * a * (1.0 + 1e-12));
+    // On the lattice of edge a, whose sites sit at odd multiples of a/2 (the
+    // coarse lattice has an even number of points per axis here).
+    for (int k = 0; k < 3; ++k) {
+      const double u = cells.cube_centre(i)[k] / (0.5 * a);
+      EXPECT_NEAR(u, std::round(u), 1e-9) << "cell " << i;
+      EXPECT_EQ(std::lround(u) % 2 != 0, true) << "cell " << i;
+    }
+    // The centroid lies in its cube.
+    for (int k = 0; k < 3; ++k)
+      EXPECT_LE(std::abs(cells.local_positions[i][k] - cells.cube_centre(i)[k]),
+                half[k] * (1.0 + 1e-12));
+  }
+  EXPECT_NEAR(volume, 4.0 / 3.0 * kPi * kR * kR * kR, 1e-12 * kR * kR * kR);
+  EXPECT_LE(cubes, static_cast<double>(plain.size()) * h * h * h * (1.0 + 1e-12));
+  EXPECT_EQ(edges.size(), 4u);
+  EXPECT_NEAR(*edges.begin(), h / 8.0, 1e-15);
+  // The finest cells are those nearest the point.
+  double nearest = 1e9;
+  int nearest_cell = -1;
+  for (int i = 0; i < cells.size(); ++i)
+    if (norm(cells.local_positions[i] - P) < nearest)
+      nearest = norm(cells.local_positions[i] - P), nearest_cell = i;
+  EXPECT_NEAR(2.0 * cells.cube_half(nearest_cell).x, h / 8.0, 1e-15);
+}
+
+// 2. Bad zones are refused with a message naming the body.
+TEST(RefinedZone, BadZonesAreRefused) {
+  MagneticModel model;
+  const double h = kR / 4.0;
+  EXPECT_THROW(
+      model.add_body("box", Box{{0.01, 0.01, 0.01}}, linear_soft(100), h, {{{0, 0, 0}, {h}}}),
+      std::invalid_argument);
+  EXPECT_THROW(model.add_body("ball", Sphere{kR}, linear_soft(100), h, {{{0, 0, 0}, {-h}}}),
+               std::invalid_argument);
+  EXPECT_THROW(model.add_body("ball", Sphere{kR}, linear_soft(100), h, {{{0, 0, NAN}, {h}}}),
+               std::invalid_argument);
+  EXPECT_THROW(
+      model.add_body("ball", Sphere{kR}, linear_soft(100), h, {{{0, 0, 0}, {h, h, h, h, h}}}),
+      std::invalid_argument);
+  EXPECT_THROW(model.add_body("one cell", Sphere{kR}, linear_soft(100), 0.0, {{{0, 0, 0}, {h}}}),
+               std::invalid_argument);
+  MagneticModel dipoles(IntraBodyTensor::point_dipole);
+  EXPECT_THROW(dipoles.add_body("ball", Sphere{kR}, linear_soft(100), h, {{{0, 0, kR}, {h}}}),
+               std::invalid_argument);
+  try {
+    model.add_body("the box", Box{{0.01, 0.01, 0.01}}, linear_soft(100), h, {{{0, 0, 0}, {h}}});
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("the box"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(model.body_count(), 0);
+}
+
+// The force on ball 2 of two linear balls (chi), ball 1 at the origin, ball 2
+// at (2 + gap) R along the unit vector line, in the uniform field H0; each
+// ball refined towards the other (zones at their nearest points, the default
+// radii) when refine is set.
+struct PairResult {
+  Vec3 force;
+  int cells_per_ball = 0;
+  int iterations = 0;
+  bool converged = false;
+};
+
+PairResult refined_pair(double R_over_h, double gap_over_R, const Vec3& line, const Vec3& H0,
+                        double chi, bool refine) {
+  const double h = kR / R_over_h;
+  MagneticModel model;
+  std::vector<RefinedZone> lower, upper;
+  if (refine) {
+    lower = {{kR * line, default_refinement_radii(h)}};
+    upper = {{-kR * line, default_refinement_radii(h)}};
+  }
+  model.add_body("lower", Sphere{kR}, linear_soft(chi), h, lower);
+  model.add_body("upper", Sphere{kR}, linear_soft(chi), h, upper);
+  MagneticState state = make_state(model, 7);
+  state.pose[1] = {Mat3{}, (2.0 + gap_over_R) * kR * line};
+  state.external_field = H0;
+  auto backend = make_cpu_backend(1);
+  const RelaxReport report =
+      magnetic_step(model, state, RelaxOptions{}, *backend);  // default iteration cap
+  return {state.force[1], model.body(0).cell_count(), report.iterations, report.converged};
+}
+
+// 3. Issue 12's open row: two lattice balls near contact in a field along
+// their line of centres, at R/h = 4.5 (565 cells per ball plain). With the
+// line along a lattice axis the plain lattice's force is 22% / 10% too weak
+// at 0.05 R / 0.1 R; along (1, 2, 2) / 3, where the contact point lies
+// nowhere special on the lattice, -26% / -7% (benchmarks/results/
+// refined_contact.md). With the default zones (915 / 953 cells per ball) the
+// force is within 3% of the exact two-centre series: measured within 1.4%
+// at chi = 1000, -1.7% at chi = 10, +2.2% at chi = 1e4 (a third line), and
+// within 0.7% with the field across the line.
+TEST(RefinedZone, TwoBallsNearContactMatchTheExactForce) {
+  struct Case {
+    double gap;
+    Vec3 line;
+    double chi;
+    bool across;
+  };
+  const Vec3 axial{0, 0, 1}, tilted = Vec3{1, 2, 2} / 3.0,
+                             oblique = Vec3{0.3, 0.5, 0.81} / norm(Vec3{0.3, 0.5, 0.81});
+  const Case cases[] = {{0.05, axial, 1000, false},  {0.1, axial, 1000, false},
+                        {0.05, tilted, 1000, false}, {0.1, tilted, 1000, false},
+                        {0.05, tilted, 1000, true},  {0.05, tilted, 10, false},
+                        {0.05, oblique, 1e4, false}};
+  for (const Case& c : cases) {
+    const Vec3 H0 = c.across ? 1e3 * normalized(cross(c.line, Vec3{0, 0, 1})) : 1e3 * c.line;
+    const auto ref = reference::two_linear_spheres_in_uniform_field(
+        kR, c.chi, kR, c.chi, {0, 0, 0}, (2.0 + c.gap) * kR * c.line, H0);
+    const PairResult r = refined_pair(4.5, c.gap, c.line, H0, c.chi, true);
+    const double e = norm(r.force - ref.force_on_2) / norm(ref.force_on_2);
+    std::printf(
+        "[odemag] refined balls, gap %g R, line (%.2f, %.2f, %.2f), chi %g, field %s: %d cells per "
+        "ball,"
+        " force error %.3e (%d iterations)\n",
+        c.gap, c.line.x, c.line.y, c.line.z, c.chi, c.across ? "across" : "along", r.cells_per_ball,
+        e, r.iterations);
+    EXPECT_TRUE(r.converged);
+    EXPECT_LE(r.cells_per_ball, 1000);
+    EXPECT_LT(e, 0.03) << "gap " << c.gap << " R, chi " << c.chi;
+  }
+}
+
+// 4. The refinement is what recovers it: the same lattice without zones
+// is off by more than 10% at 0.05 R (measured -15.4%).
+TEST(RefinedZone, WithoutZonesTheSameLatticeIsFarOff) {
+  const Vec3 line{0, 0, 1}, H0{0, 0, 1e3};
+  const auto ref = reference::two_linear_spheres_in_uniform_field(kR, 1000, kR, 1000, {0, 0, 0},
+                                                                  {0, 0, 2.05 * kR}, H0);
+  const PairResult r = refined_pair(4.5, 0.05, line, H0, 1000, false);
+  const double e = norm(r.force - ref.force_on_2) / norm(ref.force_on_2);
+  EXPECT_GT(e, 0.1);
+}
+
+// 5. A refined ball in a uniform field takes the continuum sphere's moment
+// (M = 3 chi / (chi + 3) H0: the boundary correction's uniform modes), to
+// the relaxation's tolerance.
+TEST(RefinedZone, RefinedBallTakesTheSpheresMomentInAUniformField) {
+  for (double chi : {10.0, 1000.0}) {
+    const double h = kR / 4.0;
+    MagneticModel model;
+    model.add_body("ball", Sphere{kR}, linear_soft(chi), h,
+                   {{{0, 0, kR}, default_refinement_radii(h)}});
+    MagneticState state = make_state(model, 3);
+    state.external_field = {0, 0, 1e3};
+    auto backend = make_cpu_backend(1);
+    ASSERT_TRUE(magnetic_step(model, state, RelaxOptions{}, *backend).converged);
+    const double exact = 3.0 * chi / (chi + 3.0) * 1e3 * (4.0 / 3.0 * kPi * kR * kR * kR);
+    const Vec3 m = body_moment(model, state, 0);
+    EXPECT_NEAR(m.z / exact, 1.0, 1e-3) << "chi " << chi;
+    EXPECT_LT(std::hypot(m.x, m.y), 1e-3 * exact);
+  }
+}
+
+}  // namespace
+}  // namespace odemag
