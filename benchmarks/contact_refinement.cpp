@@ -23,7 +23,7 @@
 // Against the two-centre series of tests/support/contact_references.h.
 //
 // Usage: contact_refinement [R/h] [--chi X] [--across] [--sites] [--cap] [--dipoles]
-//                           [--zone D0,D1,...]...
+//                           [--zone D0,D1,...]... [--line x,y,z]
 //   R/h: with 2R/h an integer (4, 5.5, 6.5), so that the lattices nest;
 //   --chi: the balls' susceptibility (1000); --across: the field across the
 //   line of centres;
@@ -34,7 +34,9 @@
 //   --dipoles: between bodies, point dipoles at the centroids (the engine's
 //   dense sums, which is what bodies of refined zones get) instead of cubes;
 //   --zone: a row of zone radii / h (repeatable; "0" for none) instead of
-//   the default list.
+//   the default list;
+//   --line: the line of centres (default z; the force is its component
+//   along the line).
 // The refined cells here are this program's own: a cube exactly D_l from
 // the point is refined or not as rounding decides, where the engine's
 // make_refined_cells leaves such ties unrefined (the same radii give it
@@ -127,7 +129,7 @@ std::vector<Cell> ball_cells(double R, double h, const Vec3& P, const std::vecto
 }
 
 struct Result {
-  double force_z;
+  double force_along;  // F_2 . line, N
   int cells_per_ball;
   double seconds;
 };
@@ -139,25 +141,35 @@ struct Options {
   bool cap = false;       // the engine's boundary correction (capped, uniform-mode update)
   bool dipoles = false;   // point dipoles at the centroids between bodies (the engine's dense sums)
   std::vector<std::vector<double>> zones;  // per row the zone radii / h (empty: the default list)
+  Vec3 line{0, 0, 1};  // unit vector from ball 1 to ball 2
 };
 
 Result solve(double R, double h, double gap_over_R, const std::vector<double>& D, const Vec3& H0,
              const Options& options) {
   const auto t0 = std::chrono::steady_clock::now();
   const double chi = options.chi;
-  std::vector<Cell> cells = ball_cells(R, h, {0, 0, R}, D);
+  const Vec3& u = options.line;
+  const bool along_z = u.x == 0.0 && u.y == 0.0;
+  std::vector<Cell> cells = ball_cells(R, h, R * u, D);
   const int per_ball = static_cast<int>(cells.size());
-  const double c2 = (2.0 + gap_over_R) * R;
-  for (int i = 0; i < per_ball; ++i) {  // ball 2: the mirror image in z, moved up
-    Cell c = cells[i];
-    c.site.z = -c.site.z;
-    c.centroid.z = -c.centroid.z;
-    c.body = 1;
-    cells.push_back(c);
+  const Vec3 c2 = (2.0 + gap_over_R) * R * u;
+  if (along_z) {
+    for (int i = 0; i < per_ball; ++i) {  // ball 2: the mirror image in z, moved up
+      Cell c = cells[i];
+      c.site.z = -c.site.z;
+      c.centroid.z = -c.centroid.z;
+      c.body = 1;
+      cells.push_back(c);
+    }
+  } else {  // ball 2 refined towards ball 1
+    for (Cell c : ball_cells(R, h, -R * u, D)) {
+      c.body = 1;
+      cells.push_back(c);
+    }
   }
   const int n = static_cast<int>(cells.size());
   auto world = [&](const Cell& c) {
-    return (options.at_sites ? c.site : c.centroid) + Vec3{0, 0, c.body == 1 ? c2 : 0.0};
+    return (options.at_sites ? c.site : c.centroid) + (c.body == 1 ? c2 : Vec3{});
   };
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(3 * n, 3 * n);
 #pragma omp parallel for schedule(dynamic, 8)
@@ -183,11 +195,15 @@ Result solve(double R, double h, double gap_over_R, const std::vector<double>& D
       A.block<3, 3>(3 * i, 3 * j) = w * N;
       if (a.body == b.body) sum += w * N;
     }
-    // Own cube (w_i I/3) minus K_i = sum_{j in body} N_ij w_j - I/3.
+    // The engine's split (magnetics/model.cpp build_boundary_correction): the
+    // cell's own I/3 (gamma_D = 1/3 + 1/chi) and K_i = I/3 + sum_{j != i} w_j
+    // N_ij - Nbar_i, Nbar_i = I/3 for a ball, its eigenvalues capped at (1 -
+    // w_i)/3 with --cap. (Until stop 43 the cap was applied to K_i - (1 - w_i)
+    // I/3, the same operator uncapped but a looser cap.)
     const double wi = a.share();
-    Eigen::Matrix3d K = sum + (wi - 1.0) / 3.0 * Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d K = sum;
     if (options.cap) K = capped_boundary_correction(K, (1.0 - wi) / 3.0);  // the engine's local part
-    A.block<3, 3>(3 * i, 3 * i) = wi / 3.0 * Eigen::Matrix3d::Identity() - K;
+    A.block<3, 3>(3 * i, 3 * i) = Eigen::Matrix3d::Identity() / 3.0 - K;
     A.block<3, 3>(3 * i, 3 * i) += Eigen::Matrix3d::Identity() / chi;
   }
   // In moments: S = W A (W = diag(V), symmetric), S M = W H0.
@@ -222,20 +238,22 @@ Result solve(double R, double h, double gap_over_R, const std::vector<double>& D
     const Cell& a = cells[i];
     const double ha[3] = {0.5 * a.edge, 0.5 * a.edge, 0.5 * a.edge};
     const Eigen::Vector3d Mi = M.segment<3>(3 * i);
-    for (int j = per_ball; j < n; ++j) {
+    for (int j = per_ball; j < static_cast<int>(cells.size()); ++j) {
       const Cell& b = cells[j];
       const double hb[3] = {0.5 * b.edge, 0.5 * b.edge, 0.5 * b.edge};
       const Vec3 d = world(a) - world(b);
       if (options.dipoles) {  // the force on b from a, r = x_b - x_a
         const Eigen::Vector3d Mj = M.segment<3>(3 * j);
         const Vec3 mu_a = a.volume * Vec3{Mi(0), Mi(1), Mi(2)}, mu_b = b.volume * Vec3{Mj(0), Mj(1), Mj(2)};
-        fz += dipole_force(-d, mu_a, mu_b, 0.0).z;
+        fz += dot(dipole_force(-d, mu_a, mu_b, 0.0), u);
         continue;
       }
       const double dd[3] = {d.x, d.y, d.z};
       double t[6], dt[3][6];
       cuboid_demag_tensor(ha, hb, dd, t, dt);
-      const Eigen::Matrix3d G = symmetric_matrix(dt[2]);  // dN/dd_z
+      double du[6];  // dN/dd . u
+      for (int c = 0; c < 6; ++c) du[c] = u.x * dt[0][c] + u.y * dt[1][c] + u.z * dt[2][c];
+      const Eigen::Matrix3d G = symmetric_matrix(du);
       const double w = b.share();
       fz += kMu0 * a.volume * Mi.dot(G * (w * M.segment<3>(3 * j)));
     }
@@ -263,6 +281,21 @@ bool parse_zone(const char* text, std::vector<std::vector<double>>& zones) {
   return true;
 }
 
+// "x,y,z", normalized into line; false when malformed or zero.
+bool parse_line(const char* text, Vec3& line) {
+  Vec3 v;
+  const char* p = text;
+  for (int k = 0; k < 3; ++k) {
+    char* end = nullptr;
+    v[k] = std::strtod(p, &end);
+    if (end == p || !std::isfinite(v[k]) || *end != (k < 2 ? ',' : '\0')) return false;
+    p = end + 1;
+  }
+  if (!(norm(v) > 0.0)) return false;
+  line = v / norm(v);
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -275,6 +308,8 @@ int main(int argc, char** argv) {
       options.at_sites = true;
     else if (arg == "--cap")
       options.cap = true;
+    else if (arg == "--line" && a + 1 < argc && parse_line(argv[a + 1], options.line))
+      ++a;
     else if (arg == "--dipoles")
       options.dipoles = true;
     else if (arg == "--zone" && a + 1 < argc && parse_zone(argv[a + 1], options.zones))
@@ -288,13 +323,17 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "contact_refinement: unknown argument '%s' (usage: contact_refinement [R/h] [--chi X]"
-                   " [--across] [--sites] [--cap] [--dipoles] [--zone D0,D1,...]...)\n",
+                   " [--across] [--sites] [--cap] [--dipoles] [--zone D0,D1,...]... [--line x,y,z])\n",
                    arg.c_str());
       return 2;
     }
   }
   const double h = R / k, chi = options.chi;
-  const Vec3 H0 = options.across ? Vec3{1e3, 0, 0} : Vec3{0, 0, 1e3};
+  const Vec3& u = options.line;
+  Vec3 across = cross(u, Vec3{0, 0, 1});
+  if (norm(across) < 0.1) across = {1, 0, 0};
+  const Vec3 H0 = options.across ? 1e3 / norm(across) * across : 1e3 * u;
+  if (u.x != 0.0 || u.y != 0.0) std::printf("The line of centres along (%g, %g, %g).\n", u.x, u.y, u.z);
   std::printf("R/h %g, chi %g, the field %s the line of centres, %s between bodies on their %s,"
               " %s boundary correction\n\n",
               k, chi, options.across ? "across" : "along", options.dipoles ? "point dipoles" : "cubes",
@@ -309,7 +348,8 @@ int main(int argc, char** argv) {
   const auto& zones = options.zones.empty() ? default_zones : options.zones;
   for (double g : {0.05, 0.1, 0.5}) {
     const auto ref = reference::two_linear_spheres_in_uniform_field(R, chi, R, chi, {0, 0, 0},
-                                                                    {0, 0, (2.0 + g) * R}, H0);
+                                                                    (2.0 + g) * R * u, H0);
+    const double exact = dot(ref.force_on_2, u);
     for (const std::vector<double>& zone : zones) {
       std::vector<double> D;
       std::string radii = zone.empty() ? "none" : "";
@@ -321,7 +361,7 @@ int main(int argc, char** argv) {
       }
       const Result r = solve(R, h, g, D, H0, options);
       std::printf("| %g R | %s | %d | %+.2f%% | %.1f |\n", g, radii.c_str(), r.cells_per_ball,
-                  100.0 * (std::abs(r.force_z) - std::abs(ref.force_on_2.z)) / std::abs(ref.force_on_2.z),
+                  100.0 * (std::abs(r.force_along) - std::abs(exact)) / std::abs(exact),
                   r.seconds);
       std::fflush(stdout);
     }

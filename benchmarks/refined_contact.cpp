@@ -6,8 +6,9 @@
 // iterations and the time of one magnetic step (the model built once per
 // row: its tensors are not timed).
 //
-// Each row: R/h, the line of centres (along z, or tilted along (1, 2, 2) /
-// 3, so that the contact point lies nowhere special on the lattice), chi,
+// Each row: R/h, the line of centres (along z, or along (1, 2, 2) / 3,
+// oblique to the lattice axes; its contact point R (1, 2, 2) / 3 lies on
+// lattice planes at R/h = 4.5, not at 4 or 5), chi,
 // the field along or across the line, and per gap the error of the plain
 // lattice and of the refined one (zones at the balls' nearest points, radii
 // default_refinement_radii).

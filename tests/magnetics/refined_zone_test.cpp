@@ -147,10 +147,9 @@ PairResult refined_pair(double R_over_h, double gap_over_R, const Vec3& line, co
 
 // 3. Issue 12's open row: two lattice balls near contact in a field along
 // their line of centres, at R/h = 4.5 (565 cells per ball plain). With the
-// line along a lattice axis the plain lattice's force is 22% / 10% too weak
-// at 0.05 R / 0.1 R; along (1, 2, 2) / 3, where the contact point lies
-// nowhere special on the lattice, -26% / -7% (benchmarks/results/
-// refined_contact.md). With the default zones (915 / 953 cells per ball) the
+// line along a lattice axis the plain lattice's force is 15% / 7.5% too weak
+// at 0.05 R / 0.1 R; along (1, 2, 2) / 3, oblique to the lattice axes, 26% /
+// 7% (benchmarks/results/refined_contact.md). With the default zones (915 / 953 cells per ball) the
 // force is within 3% of the exact two-centre series: measured within 1.4%
 // at chi = 1000, -1.7% at chi = 10, +2.2% at chi = 1e4 (a third line), and
 // within 0.7% with the field across the line.
