@@ -81,8 +81,8 @@ void build_pair_tensors(MagneticBody& body) {
 // a_j^3 N_ji. The diagonal is zero: a cube's own tensor is I / 3, which the
 // local relaxation holds. The cube centres lie on nested lattices, so N_ij
 // depends only on the two levels and the offset in units of the finest
-// lattice's half spacing: each distinct one is computed once (a 950-cell
-// ball has about 40 times fewer than pairs).
+// lattice's half spacing: each distinct one is computed once (a 953-cell
+// ball: 96071 of its 453628 pairs).
 void build_refined_pair_tensors(MagneticBody& body) {
   const CellSet& cells = body.cells;
   const int count = cells.size();
