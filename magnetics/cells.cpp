@@ -369,16 +369,12 @@ ShareCell share_cell(const Shape& shape, const Vec3& site, double a) {
 }
 
 // Lattice points per axis of the volume-share cells at h: ceil(extent / h),
-// so that the cubes cover the body; and the site of point (i, j, k).
+// so that the cubes cover the body.
 std::array<int, 3> volume_share_extent(const Shape& shape, double h) {
   const Vec3 half = shape_half_extents(shape);
   std::array<int, 3> n{};
   for (int a = 0; a < 3; ++a) n[a] = static_cast<int>(std::ceil(2.0 * half[a] / h - 1e-9));
   return n;
-}
-
-Vec3 lattice_site(const std::array<int, 3>& n, double h, int i, int j, int k) {
-  return {(i - 0.5 * (n[0] - 1)) * h, (j - 0.5 * (n[1] - 1)) * h, (k - 0.5 * (n[2] - 1)) * h};
 }
 
 // Volume-share cells: per axis ceil(extent / h) points, so that the cubes
@@ -390,7 +386,7 @@ CellSet volume_share_cells(const Shape& shape, double h) {
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
       for (int i = 0; i < n[0]; ++i) {
-        const ShareCell c = share_cell(shape, lattice_site(n, h, i, j, k), h);
+        const ShareCell c = share_cell(shape, lattice_site(n, h, {i, j, k}), h);
         if (c.volume == 0.0) continue;
         if (!c.whole) cells.whole_cells = false;
         cells.local_positions.push_back(c.centroid);
@@ -544,7 +540,7 @@ CellSet make_refined_cells(const Shape& shape, double cell_size, const std::vect
   };
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
-      for (int i = 0; i < n[0]; ++i) emit(emit, lattice_site(n, h, i, j, k), h, 0, {i, j, k});
+      for (int i = 0; i < n[0]; ++i) emit(emit, lattice_site(n, h, {i, j, k}), h, 0, {i, j, k});
   cells.lattice_extent = n;
   cells.spacing = h;
   cells.cell_volume = h * h * h;

@@ -10,6 +10,13 @@
 
 namespace odemag {
 
+// The site of lattice point index on a lattice of extent points per axis,
+// spacing h, centred on the body's origin.
+inline Vec3 lattice_site(const std::array<int, 3>& extent, double h, const std::array<int, 3>& index) {
+  return {(index[0] - 0.5 * (extent[0] - 1)) * h, (index[1] - 0.5 * (extent[1] - 1)) * h,
+          (index[2] - 0.5 * (extent[2] - 1)) * h};
+}
+
 // The cells of one body, in the body frame (make_cells). A volume-share
 // cell stands for the part of its cube (edge h, centred on its lattice site)
 // inside the body: its volume is that part's volume (h^3 for a whole cube)
@@ -74,9 +81,7 @@ struct CellSet {
   Vec3 cube_centre(int i) const {
     if (refined) return cube_centres[i];
     if (graded) return local_positions[i];
-    Vec3 site;
-    for (int a = 0; a < 3; ++a) site[a] = (lattice_index[i][a] - 0.5 * (lattice_extent[a] - 1)) * spacing;
-    return site;
+    return lattice_site(lattice_extent, spacing, lattice_index[i]);
   }
   Vec3 cube_half(int i) const {
     return half_extents.empty() ? Vec3{0.5 * spacing, 0.5 * spacing, 0.5 * spacing} : half_extents[i];

@@ -15,6 +15,12 @@ bool is_inert(const Material& material) {
   return std::holds_alternative<InertMaterial>(material);
 }
 
+bool has_positive_susceptibility(const Material& material) {
+  if (std::holds_alternative<SoftMaterial>(material)) return true;
+  const auto* permanent = std::get_if<PermanentMaterial>(&material);
+  return permanent && permanent->recoil_susceptibility > 0.0;
+}
+
 namespace {
 
 bool finite(const Vec3& v) { return is_finite(v); }

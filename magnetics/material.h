@@ -62,4 +62,9 @@ std::string validate_material(const Material& material);
 
 bool is_inert(const Material& material);
 
+// A soft material, or a permanent one with recoil susceptibility > 0: its
+// magnetization grows along an applied field (not inert, not rigid, not a
+// diamagnet).
+bool has_positive_susceptibility(const Material& material);
+
 }  // namespace odemag

@@ -253,11 +253,8 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
   body.shape = shape;
   body.material = material;
   body.first_cell = cell_count();
-  const bool responsive_material =
-      std::holds_alternative<SoftMaterial>(material) ||
-      (std::holds_alternative<PermanentMaterial>(material) &&
-       std::get<PermanentMaterial>(material).recoil_susceptibility > 0.0);
-  const bool graded = graded_cells_ && intra_tensor_ == IntraBodyTensor::cell_average && responsive_material &&
+  const bool graded = graded_cells_ && intra_tensor_ == IntraBodyTensor::cell_average &&
+                      has_positive_susceptibility(material) &&
                       uses_graded_cells(shape, cell_size);
   if (!zones.empty()) {
     if (is_inert(material))

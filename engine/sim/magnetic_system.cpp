@@ -18,21 +18,13 @@ BodyPose scene_pose(const BodyDescription& body) {
 
 namespace {
 
-bool responsive_material(const Material& material) {
-  if (std::holds_alternative<SoftMaterial>(material)) return true;
-  const auto* permanent = std::get_if<PermanentMaterial>(&material);
-  return permanent && permanent->recoil_susceptibility > 0.0;
-}
-
-}  // namespace
-
-std::vector<RefinedZone> scene_contact_zones(const SceneDescription& scene, int b) {
-  if (!scene.solver.contact_refinement) return {};
+// The zones of body b (scene_contact_zones).
+std::vector<RefinedZone> body_contact_zones(const SceneDescription& scene, int b) {
   const BodyDescription& body = scene.bodies[b];
   const auto* ball = std::get_if<Sphere>(&body.shape);
   const auto material = scene.materials.find(body.material);
   const double h = scene.body_cell_size(b);
-  if (!ball || material == scene.materials.end() || !responsive_material(material->second) ||
+  if (!ball || material == scene.materials.end() || !has_positive_susceptibility(material->second) ||
       !uses_volume_shares(body.shape, h))
     return {};
   const BodyPose pose = scene_pose(body);
@@ -59,8 +51,18 @@ std::vector<RefinedZone> scene_contact_zones(const SceneDescription& scene, int 
   return zones;
 }
 
+}  // namespace
+
+std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene) {
+  std::vector<std::vector<RefinedZone>> zones(scene.bodies.size());
+  if (scene.solver.contact_refinement)
+    for (size_t b = 0; b < scene.bodies.size(); ++b) zones[b] = body_contact_zones(scene, static_cast<int>(b));
+  return zones;
+}
+
 MagneticSystem build_magnetic_system(const SceneDescription& scene) {
   MagneticSystem ms;
+  const std::vector<std::vector<RefinedZone>> zones = scene_contact_zones(scene);
   ms.model.set_graded_cells(scene.solver.graded_cells);
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodyDescription& body = scene.bodies[b];
@@ -71,7 +73,7 @@ MagneticSystem build_magnetic_system(const SceneDescription& scene) {
     try {
       const int index = ms.model.add_body(body.name, body.shape, material->second,
                                           scene.body_cell_size(static_cast<int>(b)),
-                                          scene_contact_zones(scene, static_cast<int>(b)));
+                                          zones[b]);
       for (const CoilSource& coil : body.coils) ms.model.add_coil(index, coil);
     } catch (const std::invalid_argument& e) {
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
@@ -109,12 +111,13 @@ void apply_events_at_start(const SceneDescription& scene, MagneticSystem& system
 
 SceneCellCounts count_scene_cells(const SceneDescription& scene) {
   SceneCellCounts counts;
+  const std::vector<std::vector<RefinedZone>> scene_zones = scene_contact_zones(scene);
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodyDescription& body = scene.bodies[b];
     const Material& material = scene.materials.at(body.material);
     if (is_inert(material)) continue;
     const double h = scene.body_cell_size(static_cast<int>(b));
-    const std::vector<RefinedZone> zones = scene_contact_zones(scene, static_cast<int>(b));
+    const std::vector<RefinedZone>& zones = scene_zones[b];
     double cells = 1.0;
     try {
       if (h > 0.0)
@@ -123,18 +126,16 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene) {
     } catch (const std::invalid_argument& e) {  // refined zones beyond kMaxRefinedCells
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
     }
-    const auto* permanent = std::get_if<PermanentMaterial>(&material);
     counts.magnetized += cells;
-    if (!permanent || permanent->recoil_susceptibility > 0.0) counts.responsive += cells;
+    if (has_positive_susceptibility(material)) counts.responsive += cells;
   }
   return counts;
 }
 
 std::string cpu_only_feature(const SceneDescription& scene) {
   if (scene.solver.graded_cells) return "graded cells (solver.graded_cells)";
-  for (size_t b = 0; b < scene.bodies.size(); ++b)
-    if (!scene_contact_zones(scene, static_cast<int>(b)).empty())
-      return "refined contact zones (solver.contact_refinement)";
+  for (const std::vector<RefinedZone>& zones : scene_contact_zones(scene))
+    if (!zones.empty()) return "refined contact zones (solver.contact_refinement)";
   for (const auto& [name, material] : scene.materials)
     if (const auto* soft = std::get_if<SoftMaterial>(&material); soft && !soft->bh_curve.empty())
       return "a B-H curve (materials." + name + ".bh_curve)";

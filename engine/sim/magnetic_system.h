@@ -43,14 +43,15 @@ struct SceneCellCounts {
 };
 SceneCellCounts count_scene_cells(const SceneDescription& scene);
 
-// The refined contact zones of body b (docs/model.md "Refined contact
-// zones"), with solver.contact_refinement: a lattice ball of a responsive
-// material (soft, or a magnet with recoil) gets one zone, with
+// The refined contact zones of every body, indexed as scene.bodies
+// (docs/model.md "Refined contact zones"). With solver.contact_refinement, a
+// lattice ball of a material with positive susceptibility (soft, or a magnet
+// with recoil) gets one zone, with
 // default_refinement_radii, at its surface point nearest each other
 // magnetized or soft body whose nearest point lies within
 // kContactRefinementGap radii of its surface, at the scene's poses (the
-// zones stay where they are in the body frame). Empty otherwise.
-std::vector<RefinedZone> scene_contact_zones(const SceneDescription& scene, int b);
+// zones stay where they are in the body frame). Every list is empty otherwise.
+std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene);
 inline constexpr double kContactRefinementGap = 0.5;
 
 // The body's pose in the scene description.
