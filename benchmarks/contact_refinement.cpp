@@ -22,8 +22,8 @@
 // on (ball_cells).
 // Against the two-centre series of tests/support/contact_references.h.
 //
-// Usage: contact_refinement [R/h] [--chi X] [--across] [--sites] [--cap] [--dipoles]
-//                           [--zone D0,D1,...]... [--line x,y,z]
+// Usage: contact_refinement [R/h] [--chi X] [--across] [--sites] [--cap] [--cap-coarse]
+//                           [--stability] [--gap g] [--dipoles] [--zone D0,D1,...]... [--line x,y,z]
 //   R/h: with 2R/h an integer (4, 5.5, 6.5), so that the lattices nest;
 //   --chi: the balls' susceptibility (1000); --across: the field across the
 //   line of centres;
@@ -31,6 +31,11 @@
 //   diagnostic: the engine puts them on the centroids);
 //   --cap: the boundary correction as the engine's: its local part capped,
 //   and the uniform-mode update;
+//   --cap-coarse: as --cap, but the local part capped on the cells of edge h
+//   only (the refined sub-cubes take the exact one);
+//   --gap g: one gap, g R (default 0.05, 0.1, 0.5);
+//   --stability: print the smallest eigenvalue of ball 1's operator in
+//   moments, W^-1/2 S W^-1/2 (with --chi 1e12: the chi -> infinity margin);
 //   --dipoles: between bodies, point dipoles at the centroids (the engine's
 //   dense sums, which is what bodies of refined zones get) instead of cubes;
 //   --zone: a row of zone radii / h (repeatable; "0" for none) instead of
@@ -140,6 +145,9 @@ struct Options {
   bool at_sites = false;  // cubes on their sites between bodies too (else on their centroids)
   bool cap = false;       // the engine's boundary correction (capped, uniform-mode update)
   bool dipoles = false;   // point dipoles at the centroids between bodies (the engine's dense sums)
+  bool cap_coarse = false;  // with cap: the local part capped on the cells of edge h only
+  bool stability = false;   // print the smallest eigenvalue of ball 1's operator
+  std::vector<double> gaps{0.05, 0.1, 0.5};  // / R
   std::vector<std::vector<double>> zones;  // per row the zone radii / h (empty: the default list)
   Vec3 line{0, 0, 1};  // unit vector from ball 1 to ball 2
 };
@@ -202,7 +210,8 @@ Result solve(double R, double h, double gap_over_R, const std::vector<double>& D
     // I/3, the same operator uncapped but a looser cap.)
     const double wi = a.share();
     Eigen::Matrix3d K = sum;
-    if (options.cap) K = capped_boundary_correction(K, (1.0 - wi) / 3.0);  // the engine's local part
+    if (options.cap && (!options.cap_coarse || a.edge > 0.75 * h))
+      K = capped_boundary_correction(K, (1.0 - wi) / 3.0);  // the engine's local part
     A.block<3, 3>(3 * i, 3 * i) = Eigen::Matrix3d::Identity() / 3.0 - K;
     A.block<3, 3>(3 * i, 3 * i) += Eigen::Matrix3d::Identity() / chi;
   }
@@ -230,6 +239,21 @@ Result solve(double R, double h, double gap_over_R, const std::vector<double>& D
       A.block(3 * first, 3 * first, rows, rows) +=
           -SU * uSu.inverse() * SU.transpose() + B * uB.inverse() * B.transpose();
     }
+  }
+  if (options.stability) {
+    // Ball 1's operator in moments, W^-1/2 S_1 W^-1/2 (symmetric): positive
+    // definite or not (at chi -> infinity the relaxation's stability margin).
+    const Eigen::Index rows = 3 * per_ball;
+    Eigen::MatrixXd S1 = A.topLeftCorner(rows, rows);
+    for (int i = 0; i < per_ball; ++i) {
+      const double s = 1.0 / std::sqrt(cells[i].volume);
+      S1.middleRows(3 * i, 3) *= s;
+      S1.middleCols(3 * i, 3) *= s;
+    }
+    S1 = 0.5 * (S1 + S1.transpose()).eval();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S1, Eigen::EigenvaluesOnly);
+    std::printf("ball 1: smallest eigenvalue of W^-1/2 S W^-1/2 %.4g (1/chi = %.3g)\n", eig.eigenvalues()(0),
+                1.0 / chi);
   }
   const Eigen::VectorXd M = A.partialPivLu().solve(rhs);
   double fz = 0.0;
@@ -308,6 +332,12 @@ int main(int argc, char** argv) {
       options.at_sites = true;
     else if (arg == "--cap")
       options.cap = true;
+    else if (arg == "--cap-coarse")
+      options.cap = options.cap_coarse = true;
+    else if (arg == "--stability")
+      options.stability = true;
+    else if (arg == "--gap" && a + 1 < argc)
+      options.gaps = {std::atof(argv[++a])};
     else if (arg == "--line" && a + 1 < argc && parse_line(argv[a + 1], options.line))
       ++a;
     else if (arg == "--dipoles")
@@ -323,7 +353,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "contact_refinement: unknown argument '%s' (usage: contact_refinement [R/h] [--chi X]"
-                   " [--across] [--sites] [--cap] [--dipoles] [--zone D0,D1,...]... [--line x,y,z])\n",
+                   " [--across] [--sites] [--cap] [--cap-coarse] [--stability] [--gap g] [--dipoles] [--zone D0,D1,...]... [--line x,y,z])\n",
                    arg.c_str());
       return 2;
     }
@@ -337,7 +367,9 @@ int main(int argc, char** argv) {
   std::printf("R/h %g, chi %g, the field %s the line of centres, %s between bodies on their %s,"
               " %s boundary correction\n\n",
               k, chi, options.across ? "across" : "along", options.dipoles ? "point dipoles" : "cubes",
-              options.at_sites ? "sites" : "centroids", options.cap ? "the engine's" : "the exact");
+              options.at_sites ? "sites" : "centroids", options.cap_coarse ? "the engine's on the cells of edge h, the exact on sub-cubes,"
+              : options.cap      ? "the engine's"
+                                 : "the exact");
   std::printf("| gap | zone radii D_l / h (to h/2, h/4, h/8) | cells per ball | force against exact |"
               " solve (s) |\n");
   std::printf("|---|---|---|---|---|\n");
@@ -346,7 +378,7 @@ int main(int argc, char** argv) {
                                                           {1.0, 0.5}, {1.5, 0.5}, {1.5, 1.0}, {2.0, 1.0},
                                                           {1.5, 1.0, 0.25}, {1.5, 1.0, 0.5}};
   const auto& zones = options.zones.empty() ? default_zones : options.zones;
-  for (double g : {0.05, 0.1, 0.5}) {
+  for (double g : options.gaps) {
     const auto ref = reference::two_linear_spheres_in_uniform_field(R, chi, R, chi, {0, 0, 0},
                                                                     (2.0 + g) * R * u, H0);
     const double exact = dot(ref.force_on_2, u);
