@@ -13,11 +13,15 @@
 // lattice and of the refined one (zones at the balls' nearest points, radii
 // default_refinement_radii).
 //
-// Usage: refined_contact [--quick]   (--quick: R/h 4.5 only, gaps 0.05 R
-// and 0.1 R; the default takes about 10 minutes on one core)
+// Usage: refined_contact [--quick] [--contact] [--radii D0,D1,...]
+//   --quick: R/h 4.5 only, gaps 0.05 R and 0.1 R (the default takes about
+//   10 minutes on one core); --contact: every row at 0.05 R and 0.1 R, the
+//   refined balls only (the plain columns zero); --radii: the zone radii in
+//   units of h instead of default_refinement_radii.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -48,16 +52,24 @@ struct Solve {
   double seconds;
 };
 
+// The zone radii / h (empty: default_refinement_radii).
+std::vector<double> zone_radii;
+
 Solve solve(const Row& row, double gap, bool refine) {
   const double h = kR / row.R_over_h;
+  std::vector<double> radii = default_refinement_radii(h);
+  if (!zone_radii.empty()) {
+    radii.clear();
+    for (double d : zone_radii) radii.push_back(d * h);
+  }
   SoftMaterial mat;
   mat.saturation = 1e12;  // linear at these fields
   mat.susceptibility = row.chi;
   MagneticModel model;
   std::vector<RefinedZone> lower, upper;
   if (refine) {
-    lower = {{kR * row.line, default_refinement_radii(h)}};
-    upper = {{-kR * row.line, default_refinement_radii(h)}};
+    lower = {{kR * row.line, radii}};
+    upper = {{-kR * row.line, radii}};
   }
   model.add_body("lower", Sphere{kR}, mat, h, lower);
   model.add_body("upper", Sphere{kR}, mat, h, upper);
@@ -86,13 +98,25 @@ Solve solve(const Row& row, double gap, bool refine) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false;
+  bool quick = false, contact = false;
   for (int a = 1; a < argc; ++a) {
-    if (std::string(argv[a]) == "--quick") {
+    const std::string arg = argv[a];
+    if (arg == "--quick") {
       quick = true;
+    } else if (arg == "--contact") {
+      contact = true;
+    } else if (arg == "--radii" && a + 1 < argc) {
+      for (const char* p = argv[++a]; *p;) {
+        char* end = nullptr;
+        const double d = std::strtod(p, &end);
+        if (end == p || !(d > 0.0)) break;
+        zone_radii.push_back(d);
+        p = *end == ',' ? end + 1 : end;
+      }
     } else {
       std::fprintf(stderr,
-                   "refined_contact: unknown argument '%s' (usage: refined_contact [--quick])\n",
+                   "refined_contact: unknown argument '%s' (usage: refined_contact [--quick]"
+                   " [--contact] [--radii D0,D1,...])\n",
                    argv[a]);
       return 2;
     }
@@ -104,8 +128,8 @@ int main(int argc, char** argv) {
   rows.push_back({4.5, tilted, 1000, true});
   rows.push_back({4.5, tilted, 10, false});
   rows.push_back({4.5, tilted, 1e4, false});
-  const std::vector<double> gaps =
-      quick ? std::vector<double>{0.05, 0.1} : std::vector<double>{0.05, 0.1, 0.5, 1.0, 2.0, 4.0};
+  const std::vector<double> gaps = quick || contact ? std::vector<double>{0.05, 0.1}
+                                                    : std::vector<double>{0.05, 0.1, 0.5, 1.0, 2.0, 4.0};
   std::printf(
       "Two linear balls (R = 5 mm) near contact, the engine (one thread), against the exact "
       "series.\n"
@@ -118,7 +142,7 @@ int main(int argc, char** argv) {
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& row : rows)
     for (double g : gaps) {
-      const Solve plain = solve(row, g, false), refined = solve(row, g, true);
+      const Solve plain = contact ? Solve{} : solve(row, g, false), refined = solve(row, g, true);
       std::printf(
           "| %g | %s | %g | %s | %g R | %d | %.2f%% (%+.2f%%) | %d | %.2f | %d | %.2f%% (%+.2f%%) "
           "| %d | %.2f |\n",

@@ -332,9 +332,12 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   };
   sim.magnetics().compute();  // frame 0 shows the relaxed initial magnetization
   emit_frame();
+  size_t notices_shown = 0;
   while (sim.time() + 0.5 * settings.time_step < settings.duration) {
     sim.step();
     check_finite(sim);
+    for (; notices_shown < sim.notices().size(); ++notices_shown)
+      std::fprintf(stderr, "odemag run: %s\n", sim.notices()[notices_shown].c_str());
     if (sim.time() + 0.5 * settings.time_step >= next_frame_time) {
       emit_frame();
     } else if (c.state_every_step) {
@@ -390,6 +393,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
       {"magnetic_steps_skipped", skipped},  // substeps, with solver.skip_unchanged
       {"exact_solver_failures", sim.world().exact_solver_failures()},  // substeps QuickStep took instead
       {"outcomes", outcomes},
+      {"notices", sim.notices()},  // as printed while running (Simulation::notices)
   };
   if (const long failures = sim.world().exact_solver_failures(); failures > 0)
     std::fprintf(stderr,

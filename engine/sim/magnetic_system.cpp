@@ -16,28 +16,25 @@ BodyPose scene_pose(const BodyDescription& body) {
   return pose;
 }
 
-namespace {
-
-// The zones of body b (scene_contact_zones).
-std::vector<RefinedZone> body_contact_zones(const SceneDescription& scene, int b) {
+std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vector<BodyPose>& poses,
+                                 const std::vector<uint8_t>& active, int b) {
   const BodyDescription& body = scene.bodies[b];
   const auto* ball = std::get_if<Sphere>(&body.shape);
   const auto material = scene.materials.find(body.material);
-  const double h = scene.body_cell_size(b);
   if (!ball || material == scene.materials.end() || !has_positive_susceptibility(material->second) ||
-      !uses_volume_shares(body.shape, h))
+      !uses_volume_shares(body.shape, scene.body_cell_size(b)))
     return {};
-  const BodyPose pose = scene_pose(body);
-  std::vector<RefinedZone> zones;
+  const BodyPose& pose = poses[b];
+  std::vector<Vec3> points;
   for (size_t o = 0; o < scene.bodies.size(); ++o) {
     const BodyDescription& other = scene.bodies[o];
     const auto other_material = scene.materials.find(other.material);
     if (static_cast<int>(o) == b || other_material == scene.materials.end() ||
-        is_inert(other_material->second))
+        is_inert(other_material->second) || (!active.empty() && !active[o]))
       continue;
     // The other body's point nearest this ball's centre, and this ball's
     // surface point towards it.
-    const BodyPose other_pose = scene_pose(other);
+    const BodyPose& other_pose = poses[o];
     const Vec3 nearest =
         other_pose.position +
         other_pose.rotation * closest_point_in_shape(other.shape, other_pose.rotation.transpose_times(
@@ -45,9 +42,20 @@ std::vector<RefinedZone> body_contact_zones(const SceneDescription& scene, int b
     const Vec3 towards = nearest - pose.position;
     const double distance = norm(towards);
     if (!(distance > 0.0) || distance - ball->radius > kContactRefinementGap * ball->radius) continue;
-    zones.push_back(
-        {pose.rotation.transpose_times((ball->radius / distance) * towards), default_refinement_radii(h)});
+    points.push_back(pose.rotation.transpose_times((ball->radius / distance) * towards));
   }
+  return points;
+}
+
+namespace {
+
+// The zones of body b at the scene's poses (scene_contact_zones).
+std::vector<RefinedZone> body_contact_zones(const SceneDescription& scene, int b) {
+  std::vector<BodyPose> poses;
+  for (const BodyDescription& body : scene.bodies) poses.push_back(scene_pose(body));
+  std::vector<RefinedZone> zones;
+  const double h = scene.body_cell_size(b);
+  for (const Vec3& point : contact_points(scene, poses, {}, b)) zones.push_back({point, default_refinement_radii(h)});
   return zones;
 }
 
@@ -62,7 +70,7 @@ std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription
 
 MagneticSystem build_magnetic_system(const SceneDescription& scene) {
   MagneticSystem ms;
-  const std::vector<std::vector<RefinedZone>> zones = scene_contact_zones(scene);
+  ms.contact_zones = scene_contact_zones(scene);
   ms.model.set_graded_cells(scene.solver.graded_cells);
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const BodyDescription& body = scene.bodies[b];
@@ -73,7 +81,7 @@ MagneticSystem build_magnetic_system(const SceneDescription& scene) {
     try {
       const int index = ms.model.add_body(body.name, body.shape, material->second,
                                           scene.body_cell_size(static_cast<int>(b)),
-                                          zones[b]);
+                                          ms.contact_zones[b]);
       for (const CoilSource& coil : body.coils) ms.model.add_coil(index, coil);
     } catch (const std::invalid_argument& e) {
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());

@@ -2,6 +2,7 @@
 // (inert bodies are bodies without cells), so indices agree everywhere.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,6 +20,7 @@ namespace odemag {
 struct MagneticSystem {
   MagneticModel model;
   MagneticState state;  // poses from the scene, bodies with present=false inactive
+  std::vector<std::vector<RefinedZone>> contact_zones;  // by body (scene_contact_zones)
 };
 
 // Throws SceneError naming the body when a shape or material is rejected.
@@ -52,6 +54,15 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene);
 // kContactRefinementGap radii of its surface, at the scene's poses (the
 // zones stay where they are in the body frame). Every list is empty otherwise.
 std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene);
+
+// The contact points of scene_contact_zones at the given poses (indexed as
+// scene.bodies): ball b's surface points, body frame, towards each other
+// magnetized or soft body (active, when active is not empty) whose nearest
+// point lies within kContactRefinementGap radii of its surface. Empty unless
+// b is a lattice ball of a material with positive susceptibility; does not
+// look at solver.contact_refinement.
+std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vector<BodyPose>& poses,
+                                 const std::vector<uint8_t>& active, int b);
 inline constexpr double kContactRefinementGap = 0.5;
 
 // The body's pose in the scene description.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -70,6 +71,8 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
   // The magnetic model of the scene, built as for solve and field
   // (build_magnetic_system), then tied to the ODE bodies.
   MagneticSystem ms = build_magnetic_system(scene_);
+  contact_zones_ = std::move(ms.contact_zones);
+  contact_left_zones_.assign(scene_.bodies.size(), 0);
   magnetics_ = std::make_unique<MagneticForces>(
       std::move(ms.model), std::move(ms.state), scene_.solver.relax,
       backend ? std::move(backend) : make_cpu_backend(scene_.solver.threads));
@@ -340,7 +343,30 @@ void Simulation::step() {
   time_ += dt;
   ++steps_;
   outcomes_.sample(scene_, time_, dt, *world_, *magnetics_);
+  if (scene_.solver.contact_refinement) check_contact_zones();
   records_.back().wall_ms = elapsed_ms(started);
+}
+
+void Simulation::check_contact_zones() {
+  const MagneticState& state = magnetics_->state();
+  for (size_t b = 0; b < scene_.bodies.size(); ++b) {
+    if (contact_left_zones_[b] || !state.active[b]) continue;
+    for (const Vec3& point : contact_points(scene_, state.pose, state.active, static_cast<int>(b))) {
+      bool covered = false;
+      for (const RefinedZone& zone : contact_zones_[b])
+        covered = covered || norm(point - zone.point) <= zone.radii.back();
+      if (covered) continue;
+      contact_left_zones_[b] = 1;
+      char t[32];
+      std::snprintf(t, sizeof t, "%.4f", time_);
+      notices_.push_back(scene_.file + ": body '" + scene_.bodies[b].name + "' (bodies[" + std::to_string(b) +
+                         "]): at t = " + t +
+                         " s a contact lies outside its refined contact zones (solver.contact_refinement"
+                         " places them at the scene's poses), so its force there has the plain lattice's"
+                         " error");
+      break;
+    }
+  }
 }
 
 void Simulation::advance_to(double t) {

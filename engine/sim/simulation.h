@@ -12,6 +12,7 @@
 #include "engine/sim/outcomes.h"
 #include "engine/sim/rigid_world.h"
 #include "engine/scene/scene.h"
+#include "magnetics/cells.h"
 
 namespace odemag {
 
@@ -76,6 +77,10 @@ class Simulation {
   // bodies through their fields is traced to where it began), K counting
   // steps from 1 and T the end of the substep.
   std::string non_finite_message() const;
+  // Notices for the user, in the order they arose (odemag run prints each
+  // once): with solver.contact_refinement, the first time a refined ball's
+  // contact lies outside its zones (check_contact_zones).
+  const std::vector<std::string>& notices() const { return notices_; }
 
  private:
   void apply_timeline(double dt);
@@ -131,6 +136,15 @@ class Simulation {
   // and the state it ends the step in.
   std::vector<uint8_t> whole_;
   std::vector<RigidWorld::Motion> whole_end_;
+  // solver.contact_refinement: after a step, a notice, once per body, when a
+  // lattice ball's contact point (contact_points at the current poses) lies
+  // farther than its zones' finest radius from every zone point: the zones
+  // stay where the scene placed them (docs/model.md "Refined contact
+  // zones"), so such a contact has the plain lattice's error.
+  void check_contact_zones();
+  std::vector<std::vector<RefinedZone>> contact_zones_;
+  std::vector<uint8_t> contact_left_zones_;  // by body: its notice was given
+  std::vector<std::string> notices_;
   // The first body found non-finite (-1 while none), its step and time.
   int non_finite_body_ = -1;
   long non_finite_step_ = 0;

@@ -299,6 +299,9 @@ void bind_simulation(py::module_& m) {
       .def_property_readonly("outcomes", &PySimulation::outcomes)
       .def_property_readonly("time", [](const PySimulation& s) { return s.simulation().time(); })
       .def_property_readonly("steps", [](const PySimulation& s) { return s.simulation().steps(); })
+      .def_property_readonly(
+          "notices", [](const PySimulation& s) { return s.simulation().notices(); },
+          "Notices as odemag run prints them (a contact outside its refined contact zones), oldest first.")
       .def_property_readonly("time_step", [](const PySimulation& s) { return s.simulation().scene().simulation.time_step; })
       .def_property_readonly("duration", [](const PySimulation& s) { return s.simulation().scene().simulation.duration; })
       .def_property_readonly("body_names", [](const PySimulation& s) { return names(s.simulation().scene()); })

@@ -231,6 +231,30 @@ TEST_F(Cli, ContactRefinementKeyRefinesTouchingLatticeBalls) {
   EXPECT_NE(big.err.find("4000"), std::string::npos) << big.err;
 }
 
+// A run whose refined contact slides away from its zones says so: one line
+// per body on stderr and the same in summary.json "notices" (the rule:
+// engine/sim Simulation.ContactLeavingItsRefinedZoneIsNoticedOnce).
+TEST_F(Cli, RunNoticesAContactThatLeftItsRefinedZone) {
+  const fs::path scene = write("sliding.json", R"({"gravity": [0, 0, 0],
+      "simulation": {"time_step": 0.001, "duration": 0.002},
+      "external_field": [0, 0, 1000],
+      "materials": {"iron": {"type": "soft", "saturation": 1e9, "susceptibility": 10}},
+      "bodies": [{"name": "lower", "shape": {"sphere": 0.005}, "material": "iron", "cell_size": 0.0016667,
+                  "fixed": true},
+                 {"name": "upper", "shape": {"sphere": 0.005}, "material": "iron", "cell_size": 0.0016667,
+                  "position": [0, 0, 0.01025], "velocity": [2, 0, 0]}],
+      "solver": {"contact_refinement": true}})");
+  const fs::path out = dir_ / "sliding";
+  const ProgramRun r = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) +
+                              " --frames no --quiet yes --backend cpu --threads 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json notices = json::parse(read_file(out / "summary.json"))["notices"];
+  ASSERT_EQ(notices.size(), 2u) << r.err;
+  for (const json& notice : notices)
+    EXPECT_NE(r.err.find(notice.get<std::string>()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("'upper' (bodies[1])"), std::string::npos) << r.err;
+}
+
 // solver.precondition_bodies: an iron plate (chi = 1000, 8 x 8 x 2 cells) in a
 // uniform field with the block preconditioner (docs/model.md "Block
 // preconditioner") and without: the same moment to the tolerance, in fewer

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "engine/sim/magnetic_system.h"
 #include "magnetics/constants.h"
@@ -479,6 +480,48 @@ TEST(Timeline, EventsAtTimeZeroHoldBeforeTheFirstStep) {
   // A sphere of chi -> large in H_E: m = 3 V H_E (its demagnetising factor 1/3).
   const double V = 4.0 / 3.0 * kPi * std::pow(0.005, 3);
   EXPECT_NEAR(body_moment(system.model, system.state, 1).z, 3.0 * V * 1000.0, 0.01 * 3.0 * V * 1000.0);
+}
+
+// Refined contact zones stay where the scene placed them (docs/model.md
+// "Refined contact zones"): a lattice ball that slides over another gets one
+// notice, naming it, once its contact point lies farther than the zones'
+// finest radius (h/4) from the zone; balls that stay put get none, and
+// without solver.contact_refinement there is nothing to notice.
+TEST(Simulation, ContactLeavingItsRefinedZoneIsNoticedOnce) {
+  const auto scene = [](double speed, bool refine) {
+    char text[1200];
+    std::snprintf(text, sizeof text, R"({
+      "gravity": [0, 0, 0],
+      "simulation": {"time_step": 0.001},
+      "external_field": [0, 0, 1000],
+      "materials": {"iron": {"type": "soft", "saturation": 1e9, "susceptibility": 10}},
+      "bodies": [{"name": "lower", "shape": {"sphere": 0.005}, "material": "iron", "cell_size": 0.0016667,
+                  "fixed": true},
+                 {"name": "upper", "shape": {"sphere": 0.005}, "material": "iron", "cell_size": 0.0016667,
+                  "position": [0, 0, 0.01025], "velocity": [%g, 0, 0]}],
+      "solver": {"contact_refinement": %s}})",
+                  speed, refine ? "true" : "false");
+    return parse_scene(text, "sliding.json");
+  };
+  Simulation sliding(scene(2.0, true));
+  for (int s = 0; s < 4; ++s) sliding.step();
+  // The upper ball moved about 8 mm sideways: both contact points left
+  // their zones (h/4 = 0.42 mm), each noticed once.
+  ASSERT_EQ(sliding.notices().size(), 2u);
+  for (const std::string& notice : sliding.notices()) {
+    EXPECT_NE(notice.find("sliding.json"), std::string::npos) << notice;
+    EXPECT_NE(notice.find("outside its refined contact zones"), std::string::npos) << notice;
+  }
+  EXPECT_NE(sliding.notices()[0].find("'lower' (bodies[0])"), std::string::npos) << sliding.notices()[0];
+  EXPECT_NE(sliding.notices()[1].find("'upper' (bodies[1])"), std::string::npos) << sliding.notices()[1];
+
+  Simulation resting(scene(0.0, true));
+  for (int s = 0; s < 2; ++s) resting.step();
+  EXPECT_TRUE(resting.notices().empty()) << resting.notices()[0];
+
+  Simulation plain(scene(2.0, false));
+  for (int s = 0; s < 4; ++s) plain.step();
+  EXPECT_TRUE(plain.notices().empty());
 }
 
 }  // namespace
