@@ -169,3 +169,28 @@ def test_run_releases_the_gil():
     total = ticks[-1] - ticks[0]
     assert sim.steps > 0 and total > 0.05
     assert max(np.diff(ticks)) < 0.5 * total
+
+
+def test_notices_name_a_contact_that_left_its_refined_zone(tmp_path):
+    # A lattice ball sliding over another (solver.contact_refinement): one
+    # notice per body once its contact leaves the zones, as odemag run
+    # writes them to summary.json.
+    ball = {"shape": {"sphere": 0.005}, "material": "iron", "cell_size": 0.0016667}
+    scene = {
+        "gravity": [0, 0, 0],
+        "simulation": {"time_step": 0.001, "duration": 0.002},
+        "external_field": [0, 0, 1000],
+        "materials": {"iron": {"type": "soft", "saturation": 1e9, "susceptibility": 10}},
+        "bodies": [dict(ball, name="lower", fixed=True),
+                   dict(ball, name="upper", position=[0, 0, 0.01025], velocity=[2, 0, 0])],
+        "solver": {"contact_refinement": True},
+    }
+    path = tmp_path / "sliding.json"
+    path.write_text(json.dumps(scene))
+    sim = odemag.Simulation(odemag.load(path))
+    assert sim.notices == []
+    sim.run()
+    assert len(sim.notices) == 2
+    assert "'upper' (bodies[1])" in sim.notices[1]
+    summary, _ = run_cli(path, tmp_path)
+    assert sim.notices == summary["notices"]
