@@ -26,20 +26,18 @@ bool takes_body_response(const MagneticBody& body) {
          body.soft.gamma_D <= 1.0 / 3.0 + 1e-2;
 }
 
-// S = I - W^1/2 K W^1/2 / gamma_D, K_ij the field at cell i per unit moment
+namespace {
+
+// S = I - W^1/2 K W^1/2 / gamma (gamma_D for the factor), K_ij the field at cell i per unit moment
 // at cell j inside the body: the offset tensors T(l_i - l_j) (i != j; a body
 // of refined zones: its pair tensors T_ij), the
 // boundary correction's self tensors S_i (i = j) and its uniform-mode terms
 // Pi_i G_Pi Pi_j - beta_i G_beta beta_j (magnetics/model.cpp
 // build_boundary_correction). So J_ij = K_ij V_j / gamma_D.
-std::shared_ptr<const BodyResponseFactor> build_body_response(const MagneticBody& body) {
-  if (!takes_body_response(body)) return nullptr;
+Eigen::MatrixXd body_response_matrix(const MagneticBody& body, double gamma) {
   const int n = body.cell_count();
   const CellSet& cells = body.cells;
   const bool boundary = !body.self_tensors.empty();
-  auto factor = std::make_shared<BodyResponseFactor>();
-  factor->sqrt_volume.resize(3 * n);
-  for (int i = 0; i < n; ++i) factor->sqrt_volume.segment<3>(3 * i).setConstant(std::sqrt(cells.volumes[i]));
   const Eigen::Matrix3d G_pi = boundary ? eigen_matrix(body.uniform_inverse[0]) : Eigen::Matrix3d::Zero();
   const Eigen::Matrix3d G_beta = boundary ? eigen_matrix(body.uniform_inverse[1]) : Eigen::Matrix3d::Zero();
   Eigen::MatrixXd S = Eigen::MatrixXd::Identity(3 * n, 3 * n);
@@ -56,11 +54,27 @@ std::shared_ptr<const BodyResponseFactor> build_body_response(const MagneticBody
         K += symmetric_matrix(&body.uniform_tensors[12u * i]) * G_pi * symmetric_matrix(&body.uniform_tensors[12u * j]) -
              symmetric_matrix(&body.uniform_tensors[12u * i + 6]) * G_beta * symmetric_matrix(&body.uniform_tensors[12u * j + 6]);
       }
-      const double scale = std::sqrt(cells.volumes[i] * cells.volumes[j]) / body.soft.gamma_D;
+      const double scale = std::sqrt(cells.volumes[i] * cells.volumes[j]) / gamma;
       S.block<3, 3>(3 * i, 3 * j) -= scale * K;
     }
   }
-  factor->llt.compute(S);
+  return S;
+}
+
+}  // namespace
+
+bool body_operator_positive_definite(const MagneticBody& body, double gamma) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(body_response_matrix(body, gamma));
+  return llt.info() == Eigen::Success;
+}
+
+std::shared_ptr<const BodyResponseFactor> build_body_response(const MagneticBody& body) {
+  if (!takes_body_response(body)) return nullptr;
+  const int n = body.cell_count();
+  auto factor = std::make_shared<BodyResponseFactor>();
+  factor->sqrt_volume.resize(3 * n);
+  for (int i = 0; i < n; ++i) factor->sqrt_volume.segment<3>(3 * i).setConstant(std::sqrt(body.cells.volumes[i]));
+  factor->llt.compute(body_response_matrix(body, body.soft.gamma_D));
   // Not positive definite (it should be; a guard): no preconditioner.
   if (factor->llt.info() != Eigen::Success) return nullptr;
   return factor;

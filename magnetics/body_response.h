@@ -34,6 +34,12 @@ bool takes_body_response(const MagneticBody& body);
 // The factor of I - J for the body (body frame, 3 n unknowns, cell-major).
 std::shared_ptr<const BodyResponseFactor> build_body_response(const MagneticBody& body);
 
+// Whether S = I - W^1/2 K W^1/2 / gamma (the matrix the factor is of, K the
+// body's own field per unit moment with its boundary correction) is
+// positive definite: Cholesky of 3 n unknowns (9 n^3 / 3 flops), for any
+// responsive body with cells. The relaxation of a linear body whose cells
+// take M = H / gamma needs it.
+bool body_operator_positive_definite(const MagneticBody& body, double gamma);
 // Replaces r (3 n doubles, body frame) by (I - J)^-1 r.
 void solve_body_response(const BodyResponseFactor& factor, double* r);
 

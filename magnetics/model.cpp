@@ -169,10 +169,18 @@ void build_refined_pair_tensors(MagneticBody& body) {
 // So a lattice ball in a uniform field takes the continuum sphere's moment (its
 // solution is uniform), and the local part carries the boundary correction to
 // non-uniform fields (a chi = 1000 ball next to a point dipole, docs/model.md).
-void build_boundary_correction(MagneticBody& body) {
+// The local demagnetising factor of the body's cells: M = H / gamma in the
+// linear range (soft: gamma_D; a recoil magnet: 1/3 + 1/chi_r).
+double local_gamma(const MagneticBody& body) {
+  return body.kind == CellKind::soft ? body.soft.gamma_D : 1.0 / 3.0 + 1.0 / body.recoil;
+}
+
+// exact_sub_cubes: a refined body's sub-cubes take the exact local part
+// (MagneticModel::add_body decides).
+void build_boundary_correction(MagneticBody& body, bool exact_sub_cubes = false) {
   const CellSet& cells = body.cells;
   const int count = cells.size();
-  const double gamma = body.kind == CellKind::soft ? body.soft.gamma_D : 1.0 / 3.0 + 1.0 / body.recoil;
+  const double gamma = local_gamma(body);
   const bool refined = cells.refined;  // per-pair tensors (else the lattice's offset tensors)
   body.self_tensors.assign(6u * count, 0.0);
   body.uniform_tensors.assign(12u * count, 0.0);
@@ -191,10 +199,10 @@ void build_boundary_correction(MagneticBody& body) {
     const Eigen::Matrix3d S = symmetric_matrix(sum), Nbar = symmetric_matrix(nbar), I = Eigen::Matrix3d::Identity();
     const Vec3 half = cells.cube_half(i);
     const double cap = (1.0 - cells.volumes[i] / (8.0 * half.x * half.y * half.z)) / 3.0;  // (1 - w_i) / 3
-    // A refined body's sub-cubes (edge h/2 and smaller) take the exact local
-    // part: the cap there biased the contact force by +4% to +6% (docs/model.md
-    // "Refined contact zones"); the cells of edge h keep it.
-    const bool sub_cube = refined && half.x < 0.375 * cells.spacing;
+    // With exact_sub_cubes, a refined body's sub-cubes (edge h/2 and smaller)
+    // take the exact local part: the cap there biased the contact force by +4%
+    // to +6% (docs/model.md "Refined contact zones"); the cells of edge h keep it.
+    const bool sub_cube = exact_sub_cubes && refined && half.x < 0.375 * cells.spacing;
     const Eigen::Matrix3d K = sub_cube ? Eigen::Matrix3d(I / 3.0 + S - Nbar)
                                        : capped_boundary_correction(I / 3.0 + S - Nbar, cap);
     const Eigen::Matrix3d Pi = gamma * I - K + S, beta = (gamma - 1.0 / 3.0) * I + Nbar;
@@ -298,7 +306,15 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     build_pair_tensors(body);
   } else if (body.responsive() && body.cells.refined) {
     build_refined_pair_tensors(body);
-    if (body.recoil >= 0.0) build_boundary_correction(body);
+    if (body.recoil >= 0.0) {
+      // The sub-cubes' exact local part is not bounded as the cap is: keep it
+      // only where the body's operator stays positive definite (checked up to
+      // kMaxExactSubCubeCells cells), else cap every cell (docs/model.md
+      // "Refined contact zones").
+      const bool exact = body.cell_count() <= kMaxExactSubCubeCells;
+      build_boundary_correction(body, exact);
+      if (exact && !body_operator_positive_definite(body, local_gamma(body))) build_boundary_correction(body);
+    }
     body.response = build_body_response(body);
   } else if (body.responsive() && body.cell_count() > 1) {
     build_offset_tensors(body, intra_tensor_);

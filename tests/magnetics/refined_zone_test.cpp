@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "magnetics/backend.h"
+#include "magnetics/body_response.h"
 #include "magnetics/cells.h"
 #include "magnetics/constants.h"
 #include "magnetics/model.h"
@@ -150,10 +151,10 @@ PairResult refined_pair(double R_over_h, double gap_over_R, const Vec3& line, co
 // line along a lattice axis the plain lattice's force is 15% / 7.5% too weak
 // at 0.05 R / 0.1 R; along (1, 2, 2) / 3, oblique to the lattice axes, 26% /
 // 7% (benchmarks/results/refined_contact.md). With the default zones (915 / 953 cells per ball) the
-// force is within 3% of the exact two-centre series: measured -2.8% / -2.1%
-// along z, -1.1% / -0.2% along (1, 2, 2) / 3 at chi = 1000 (see the
-// refined_contact results for chi = 10, 1e4, the third line and the field
-// across).
+// force is within 3% of the exact two-centre series: measured -0.1% / +0.1%
+// along z (its sub-cubes capped: add_body's positivity check), -1.1% / -0.2%
+// along (1, 2, 2) / 3 at chi = 1000, -2.6% at chi = 10, 0.3% on the third
+// line at chi = 1e4, 0.5% with the field across.
 TEST(RefinedZone, TwoBallsNearContactMatchTheExactForce) {
   struct Case {
     double gap;
@@ -202,6 +203,33 @@ TEST(RefinedZone, ObliqueContactDoesNotOvershootOnFinerLattices) {
   EXPECT_TRUE(r.converged);
   EXPECT_GT(signed_error, -0.03);
   EXPECT_LT(signed_error, 0.01) << "the refined contact overshoots";
+}
+
+// 3c. The sub-cubes' exact boundary correction is not bounded as the cap
+// is: with the radii 1.25 h, h, h/4 at R/h = 4 along (1, 2, 2) / 3 it makes
+// the ball's operator indefinite (smallest eigenvalue -0.035 at chi -> inf,
+// benchmarks/contact_refinement --stability), and the relaxation did not
+// converge within the default cap. add_body checks the operator by Cholesky
+// and then caps every cell: the body's operator is positive definite, the
+// relaxation converges, and the force is within 3% (measured +0.7%).
+TEST(RefinedZone, IndefiniteExactCorrectionFallsBackToTheCap) {
+  const double h = kR / 4.0;
+  const Vec3 line = Vec3{1, 2, 2} / 3.0, H0 = 1e3 * line;
+  const std::vector<double> radii{1.25 * h, h, 0.25 * h};
+  MagneticModel model;
+  model.add_body("lower", Sphere{kR}, linear_soft(1000), h, {{kR * line, radii}});
+  model.add_body("upper", Sphere{kR}, linear_soft(1000), h, {{-kR * line, radii}});
+  const MagneticBody& lower = model.body(0);
+  EXPECT_TRUE(body_operator_positive_definite(lower, lower.soft.gamma_D));
+  MagneticState state = make_state(model, 7);
+  state.pose[1] = {Mat3{}, 2.05 * kR * line};
+  state.external_field = H0;
+  auto backend = make_cpu_backend(1);
+  const RelaxReport report = magnetic_step(model, state, RelaxOptions{}, *backend);
+  const auto ref = reference::two_linear_spheres_in_uniform_field(kR, 1000, kR, 1000, {0, 0, 0},
+                                                                  2.05 * kR * line, H0);
+  EXPECT_TRUE(report.converged) << report.iterations << " iterations";
+  EXPECT_LT(norm(state.force[1] - ref.force_on_2) / norm(ref.force_on_2), 0.03);
 }
 
 // 4. The refinement is what recovers it: the same lattice without zones
