@@ -138,6 +138,12 @@ void build_refined_pair_tensors(MagneticBody& body) {
     }
 }
 
+// The local demagnetising factor of the body's cells: M = H / gamma in the
+// linear range (soft: gamma_D; a recoil magnet: 1/3 + 1/chi_r).
+double local_gamma(const MagneticBody& body) {
+  return body.kind == CellKind::soft ? body.soft.gamma_D : 1.0 / 3.0 + 1.0 / body.recoil;
+}
+
 // Boundary correction (docs/model.md "Cells"). For a uniform magnetization M
 // the cells' field is H_i = -(I/3 + sum_{j != i} w_j N_ij) M (self term and
 // cube tensors of the cubes at the lattice sites, w_j = V_j / h^3), while the
@@ -169,14 +175,9 @@ void build_refined_pair_tensors(MagneticBody& body) {
 // So a lattice ball in a uniform field takes the continuum sphere's moment (its
 // solution is uniform), and the local part carries the boundary correction to
 // non-uniform fields (a chi = 1000 ball next to a point dipole, docs/model.md).
-// The local demagnetising factor of the body's cells: M = H / gamma in the
-// linear range (soft: gamma_D; a recoil magnet: 1/3 + 1/chi_r).
-double local_gamma(const MagneticBody& body) {
-  return body.kind == CellKind::soft ? body.soft.gamma_D : 1.0 / 3.0 + 1.0 / body.recoil;
-}
-
-// exact_sub_cubes: a refined body's sub-cubes take the exact local part
-// (MagneticModel::add_body decides).
+// With exact_sub_cubes a refined body's sub-cubes take the exact local part,
+// which the proof above does not cover (MagneticModel::add_body checks the
+// operator and decides).
 void build_boundary_correction(MagneticBody& body, bool exact_sub_cubes = false) {
   const CellSet& cells = body.cells;
   const int count = cells.size();
