@@ -47,24 +47,16 @@ std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vecto
   return points;
 }
 
-namespace {
-
-// The zones of body b at the scene's poses (scene_contact_zones).
-std::vector<RefinedZone> body_contact_zones(const SceneDescription& scene, int b) {
-  std::vector<BodyPose> poses;
-  for (const BodyDescription& body : scene.bodies) poses.push_back(scene_pose(body));
-  std::vector<RefinedZone> zones;
-  const double h = scene.body_cell_size(b);
-  for (const Vec3& point : contact_points(scene, poses, {}, b)) zones.push_back({point, default_refinement_radii(h)});
-  return zones;
-}
-
-}  // namespace
-
 std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene) {
   std::vector<std::vector<RefinedZone>> zones(scene.bodies.size());
-  if (scene.solver.contact_refinement)
-    for (size_t b = 0; b < scene.bodies.size(); ++b) zones[b] = body_contact_zones(scene, static_cast<int>(b));
+  if (!scene.solver.contact_refinement) return zones;
+  std::vector<BodyPose> poses;
+  for (const BodyDescription& body : scene.bodies) poses.push_back(scene_pose(body));
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    const double h = scene.body_cell_size(static_cast<int>(b));
+    for (const Vec3& point : contact_points(scene, poses, {}, static_cast<int>(b)))
+      zones[b].push_back({point, default_refinement_radii(h)});
+  }
   return zones;
 }
 
