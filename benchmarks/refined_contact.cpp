@@ -13,11 +13,16 @@
 // lattice and of the refined one (zones at the balls' nearest points, radii
 // default_refinement_radii).
 //
-// Usage: refined_contact [--quick] [--contact] [--radii D0,D1,...]
+// Usage: refined_contact [--quick] [--contact] [--rolling] [--radii D0,D1,...]
 //   --quick: R/h 4.5 only, gaps 0.05 R and 0.1 R (the default takes about
 //   10 minutes on one core); --contact: every row at 0.05 R and 0.1 R, the
 //   refined balls only (the plain columns zero); --radii: the zone radii in
-//   units of h instead of default_refinement_radii.
+//   units of h instead of default_refinement_radii; --rolling: the upper
+//   ball moved around the lower one at 0.05 R (the line of centres turned
+//   from z towards x), the zones either left where they were placed for the
+//   line along z or moved to the new contact points
+//   (MagneticModel::refine_body, transfer_refined_state), as
+//   solver.contact_refinement does in a run.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -95,31 +100,103 @@ Solve solve(const Row& row, double gap, bool refine) {
           model.body(0).cell_count(), report.converged ? report.iterations : -1, seconds};
 }
 
+// --rolling: the zones placed for the line along z, the upper ball then at
+// angle theta from z in the xz plane, 0.05 R apart, chi = 1000, the field
+// along the line. Stationary zones: the model of theta = 0 relaxed there;
+// moved: refine_body on both balls (from the state relaxed at theta = 0,
+// as a run carries it) and relaxed.
+void rolling() {
+  const double R_over_h = 4.5, h = kR / R_over_h, gap = 0.05, chi = 1000.0;
+  const std::vector<double> radii = default_refinement_radii(h);
+  SoftMaterial mat;
+  mat.saturation = 1e12;
+  mat.susceptibility = chi;
+  auto backend = make_cpu_backend(1);
+  auto seconds_since = [](std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  std::printf(
+      "Two linear balls (R = 5 mm, R/h = 4.5, chi = 1000), 0.05 R apart, the field along the line "
+      "of centres, the line turned by theta from z towards x; zones placed for theta = 0. The "
+      "engine, one thread; error of the force against the exact series (signed: of the exact "
+      "force's component).\n\n");
+  std::printf(
+      "| theta (deg) | contact moved (h) | stationary zones: error | iterations |"
+      " moved zones: error | iterations | cells per ball | refine_body, both balls (s) |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  for (const double degrees : {0.0, 5.0, 10.0, 20.0, 30.0, 45.0}) {
+    const double theta = degrees * 3.14159265358979323846 / 180.0;
+    const Vec3 line{std::sin(theta), 0.0, std::cos(theta)}, H0 = 1e3 * line;
+    const auto ref = reference::two_linear_spheres_in_uniform_field(kR, chi, kR, chi, {0, 0, 0},
+                                                                    (2.0 + gap) * kR * line, H0);
+    const Vec3& F = ref.force_on_2;
+    MagneticModel model;
+    model.add_body("lower", Sphere{kR}, mat, h, {{{0, 0, kR}, radii}});
+    model.add_body("upper", Sphere{kR}, mat, h, {{{0, 0, -kR}, radii}});
+    MagneticState state = make_state(model, 7);
+    state.pose[1] = {Mat3{}, {0, 0, (2.0 + gap) * kR}};
+    state.external_field = {0, 0, 1e3};
+    // Relaxed at theta = 0, as before the move.
+    magnetic_step(model, state, RelaxOptions{}, *backend);
+    state.pose[1] = {Mat3{}, (2.0 + gap) * kR * line};
+    state.external_field = H0;
+    MagneticState stationary = state;
+    const RelaxReport still = magnetic_step(model, stationary, RelaxOptions{}, *backend);
+    const auto t0 = std::chrono::steady_clock::now();
+    const MagneticBody lower = model.refine_body(0, {{kR * line, radii}});
+    transfer_refined_state(model, 0, lower, state);
+    const MagneticBody upper = model.refine_body(1, {{-kR * line, radii}});
+    transfer_refined_state(model, 1, upper, state);
+    const double refine_seconds = seconds_since(t0);
+    const RelaxReport moved = magnetic_step(model, state, RelaxOptions{}, *backend);
+    auto signed_error = [&](const Vec3& f) { return 100.0 * (dot(f, F) / dot(F, F) - 1.0); };
+    std::printf("| %g | %.2f | %+.2f%% | %d | %+.2f%% | %d | %d | %.2f |\n", degrees,
+                kR * theta / h, signed_error(stationary.force[1]),
+                still.converged ? still.iterations : -1, signed_error(state.force[1]),
+                moved.converged ? moved.iterations : -1, model.body(0).cell_count(),
+                refine_seconds);
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, contact = false;
+  bool quick = false, contact = false, roll = false;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--quick") {
       quick = true;
     } else if (arg == "--contact") {
       contact = true;
+    } else if (arg == "--rolling") {
+      roll = true;
     } else if (arg == "--radii" && a + 1 < argc) {
-      for (const char* p = argv[++a]; *p;) {
+      const char* list = argv[++a];
+      for (const char* p = list;;) {
         char* end = nullptr;
         const double d = std::strtod(p, &end);
-        if (end == p || !(d > 0.0)) break;
+        if (end == p || !(d > 0.0) || !std::isfinite(d) || (*end != ',' && *end != '\0')) {
+          std::fprintf(stderr,
+                       "refined_contact: --radii '%s': positive numbers separated by commas\n",
+                       list);
+          return 2;
+        }
         zone_radii.push_back(d);
-        p = *end == ',' ? end + 1 : end;
+        if (*end == '\0') break;
+        p = end + 1;
       }
     } else {
       std::fprintf(stderr,
                    "refined_contact: unknown argument '%s' (usage: refined_contact [--quick]"
-                   " [--contact] [--radii D0,D1,...])\n",
+                   " [--contact] [--rolling] [--radii D0,D1,...])\n",
                    argv[a]);
       return 2;
     }
+  }
+  if (roll) {
+    rolling();
+    return 0;
   }
   const Vec3 axial{0, 0, 1}, tilted = Vec3{1, 2, 2} / 3.0;
   std::vector<Row> rows;

@@ -254,8 +254,9 @@ std::string validate_body_lattice(const std::string& name, const Shape& shape, d
   return msg.str();
 }
 
-int MagneticModel::add_body(const std::string& name, const Shape& shape, const Material& material,
-                            double cell_size, const std::vector<RefinedZone>& zones) {
+MagneticBody MagneticModel::make_body(const std::string& name, const Shape& shape,
+                                      const Material& material, double cell_size,
+                                      const std::vector<RefinedZone>& zones) const {
   if (std::string e = validate_shape(shape); !e.empty()) throw std::invalid_argument(e);
   if (std::string e = validate_material(material); !e.empty()) throw std::invalid_argument(e);
   if (!std::isfinite(cell_size)) throw std::invalid_argument("cell_size must be finite");
@@ -266,7 +267,7 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
   body.name = name;
   body.shape = shape;
   body.material = material;
-  body.first_cell = cell_count();
+  body.cell_size = cell_size;
   const bool graded = graded_cells_ && intra_tensor_ == IntraBodyTensor::cell_average &&
                       has_positive_susceptibility(material) &&
                       uses_graded_cells(shape, cell_size);
@@ -325,8 +326,14 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     body.response = build_body_response(body);
   }
 
+  return body;
+}
+
+void MagneticModel::append_cells(int b) {
+  MagneticBody& body = bodies_[b];
+  body.first_cell = cell_count();
   for (int c = 0; c < body.cell_count(); ++c) {
-    cell_body_.push_back(body_count());
+    cell_body_.push_back(b);
     if (body.kind == CellKind::soft) {
       moment_offset_.push_back(moment_count_);
       moment_count_ += body.soft.n;
@@ -336,9 +343,29 @@ int MagneticModel::add_body(const std::string& name, const Shape& shape, const M
     }
     if (body.responsive()) ++responsive_cells_;
   }
-  bodies_.push_back(std::move(body));
+}
+
+int MagneticModel::add_body(const std::string& name, const Shape& shape, const Material& material,
+                            double cell_size, const std::vector<RefinedZone>& zones) {
+  bodies_.push_back(make_body(name, shape, material, cell_size, zones));
+  append_cells(body_count() - 1);
   generation_.bump();
   return body_count() - 1;
+}
+
+MagneticBody MagneticModel::refine_body(int b, const std::vector<RefinedZone>& zones) {
+  if (b < 0 || b >= body_count())
+    throw std::out_of_range("MagneticModel::refine_body: no body " + std::to_string(b) +
+                            " (the model has " + std::to_string(body_count()) + ")");
+  const MagneticBody& old = bodies_[b];
+  MagneticBody body = make_body(old.name, old.shape, old.material, old.cell_size, zones);
+  std::swap(bodies_[b], body);
+  cell_body_.clear();
+  moment_offset_.clear();
+  moment_count_ = soft_cells_ = responsive_cells_ = 0;
+  for (int i = 0; i < body_count(); ++i) append_cells(i);
+  generation_.bump();
+  return body;
 }
 
 void MagneticModel::add_coil(int body, const CoilSource& source) {

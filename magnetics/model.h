@@ -32,6 +32,7 @@ struct MagneticBody {
   Shape shape;
   Material material;
   CellSet cells;         // empty for inert bodies
+  double cell_size = 0.0;  // h as given to MagneticModel::add_body, m (<= 0: one cell)
   int first_cell = 0;    // index of the first cell in the model's cell arrays
   CellKind kind = CellKind::fixed_permanent;
   SoftCellParams soft;   // for soft bodies (easy axis normalised, body frame)
@@ -170,6 +171,16 @@ class MagneticModel {
   int add_body(const std::string& name, const Shape& shape, const Material& material, double cell_size,
                const std::vector<RefinedZone>& zones = {});
 
+  // Gives body b new refined zones (docs/model.md "Refined contact zones";
+  // none: its plain cells again): its cells, tensors, boundary correction
+  // and response are built anew, as add_body builds them with its shape,
+  // material and cell size; the other bodies keep theirs, their cells
+  // renumbered. Returns the body as it was (transfer_refined_state carries
+  // the state over). Throws std::out_of_range on a bad index, and
+  // std::invalid_argument, leaving the model unchanged, for zones add_body
+  // refuses.
+  MagneticBody refine_body(int b, const std::vector<RefinedZone>& zones);
+
   // Attaches a current source to body `body` (body frame). Throws
   // std::invalid_argument on a bad index or geometry (coil_source_error).
   void add_coil(int body, const CoilSource& source);
@@ -199,6 +210,12 @@ class MagneticModel {
   int responsive_cell_count() const { return responsive_cells_; }
 
  private:
+  // The body add_body would add (first_cell unset); throws as add_body does.
+  MagneticBody make_body(const std::string& name, const Shape& shape, const Material& material,
+                         double cell_size, const std::vector<RefinedZone>& zones) const;
+  // Numbers body b's cells after the cells of the bodies before it.
+  void append_cells(int b);
+
   IntraBodyTensor intra_tensor_ = IntraBodyTensor::cell_average;
   bool graded_cells_ = false;
   std::vector<MagneticBody> bodies_;

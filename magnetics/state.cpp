@@ -1,5 +1,8 @@
 #include "magnetics/state.h"
 
+#include <cmath>
+#include <cstddef>
+
 #include "magnetics/constants.h"
 #include "magnetics/kernels.h"
 #include "magnetics/rng.h"
@@ -44,6 +47,70 @@ void extend_state(const MagneticModel& model, MagneticState& state) {
   state.moments.resize(model.moment_count());
   state.moment_hc_prev.resize(model.moment_count());
   for (int b = old_bodies; b < model.body_count(); ++b) reset_moments(model, state, b);
+}
+
+namespace {
+
+// The old cell of a refined body each new cell takes its state from
+// (transfer_refined_state).
+std::vector<int> source_cells(const CellSet& old_cells, const CellSet& cells) {
+  std::vector<int> source(cells.size());
+  for (int i = 0; i < cells.size(); ++i) {
+    const Vec3 p = cells.cube_centre(i);
+    int best = -1, nearest = 0;
+    double best_edge = 0.0, nearest_distance = 0.0;
+    for (int j = 0; j < old_cells.size(); ++j) {
+      const Vec3 d = p - old_cells.cube_centre(j), half = old_cells.cube_half(j);
+      const double slack = 1e-9 * half.x;
+      if (std::abs(d.x) <= half.x + slack && std::abs(d.y) <= half.y + slack &&
+          std::abs(d.z) <= half.z + slack && (best < 0 || half.x < best_edge))
+        best = j, best_edge = half.x;
+      const double distance = norm(p - old_cells.local_positions[j]);
+      if (j == 0 || distance < nearest_distance) nearest = j, nearest_distance = distance;
+    }
+    source[i] = best >= 0 ? best : nearest;
+  }
+  return source;
+}
+
+// v with the block of old_count * width entries at first replaced by, for
+// each new cell i, the width entries of old cell source[i].
+template <class T>
+std::vector<T> remapped(const std::vector<T>& v, size_t first, size_t width, size_t old_count,
+                        const std::vector<int>& source, T cleared = T{}, bool clear = false) {
+  std::vector<T> out(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(first));
+  for (const int s : source)
+    for (size_t k = 0; k < width; ++k) out.push_back(clear ? cleared : v[first + s * width + k]);
+  out.insert(out.end(), v.begin() + static_cast<std::ptrdiff_t>(first + old_count * width),
+             v.end());
+  return out;
+}
+
+}  // namespace
+
+void transfer_refined_state(const MagneticModel& model, int b, const MagneticBody& old_body,
+                            MagneticState& state) {
+  const MagneticBody& body = model.body(b);
+  const std::vector<int> source = source_cells(old_body.cells, body.cells);
+  const size_t first = static_cast<size_t>(body.first_cell),
+               old_count = static_cast<size_t>(old_body.cell_count());
+  state.cell_position = remapped(state.cell_position, first, 1, old_count, source);
+  state.magnetization = remapped(state.magnetization, first, 1, old_count, source);
+  state.applied_field = remapped(state.applied_field, first, 1, old_count, source);
+  state.relaxation_change =
+      remapped(state.relaxation_change, first, 1, old_count, source, Vec3{}, true);
+  state.previous_relaxation_change =
+      remapped(state.previous_relaxation_change, first, 1, old_count, source, Vec3{}, true);
+  state.llg_history = remapped(state.llg_history, first, 1, old_count, source);
+  state.noise_counter = remapped(state.noise_counter, first, 1, old_count, source);
+  if (body.kind == CellKind::soft && body.cell_count() > 0) {
+    const size_t n = static_cast<size_t>(body.soft.n),
+                 first_moment = static_cast<size_t>(model.moment_offset(body.first_cell));
+    state.moments = remapped(state.moments, first_moment, n, old_count, source);
+    state.moment_hc_prev = remapped(state.moment_hc_prev, first_moment, n, old_count, source);
+  }
+  state.last_solve.valid = false;
+  place_cells(model, state);
 }
 
 MagneticState make_state(const MagneticModel& model, uint64_t seed) {

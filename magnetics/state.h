@@ -75,6 +75,18 @@ MagneticState make_state(const MagneticModel& model, uint64_t seed = 1);
 // added to the model later, e.g. by the embedding API).
 void extend_state(const MagneticModel& model, MagneticState& state);
 
+// After MagneticModel::refine_body(b) returned old_body: the state for the
+// model's new cells. The other bodies' cells keep theirs (renumbered). A new
+// cell of body b takes the moments, magnetization, applied field, LLG history
+// and noise counter of the old cell whose cube holds its cube's centre (the
+// smallest such cube; the old cell point nearest it where none does), so the
+// magnetization carries over as the old cells held it; the warm-start
+// changes of b's cells are cleared and last_solve is invalidated (the next
+// magnetic step relaxes). Cell positions and magnetizations are placed
+// again (place_cells).
+void transfer_refined_state(const MagneticModel& model, int b, const MagneticBody& old_body,
+                            MagneticState& state);
+
 // Soft cells back to the unmagnetized random opposite pairs of make_state.
 void reset_moments(const MagneticModel& model, MagneticState& state, int body);
 

@@ -280,8 +280,8 @@ const std::vector<std::string>& summary_figures() {
     std::vector<std::string> f = {"bodies", "cells", "responsive_cells", "time_step", "duration", "steps",
                                   "frames", "wall_seconds", "steps_not_converged", "magnetic_steps_skipped",
                                   "exact_solver_failures"};
-    for (const char* group : {"magnetic_ms", "rigid_ms", "iterations", "substeps", "sleeping", "held",
-                              "whole_step"})
+    for (const char* group : {"magnetic_ms", "rigid_ms", "iterations", "substeps", "sleeping",
+                              "held", "whole_step", "rezoned"})
       for (const char* s : {"median", "p90", "mean", "max", "total"}) f.push_back(std::string(group) + "." + s);
     return f;
   }();
@@ -352,7 +352,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
 
   // summary.json: the cost of every rigid step and the scene's outcomes
   // (summary_figures() lists its numbers for sweeps: keep the two together).
-  std::vector<double> tm, tr, iterations, substeps, sleeping, held, whole_step;
+  std::vector<double> tm, tr, iterations, substeps, sleeping, held, whole_step, rezoned;
   long not_converged = 0, skipped = 0;
   for (const StepRecord& r : sim.records()) {
     tm.push_back(r.magnetic_ms);
@@ -362,6 +362,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
     sleeping.push_back(r.sleeping);
     held.push_back(r.held);
     whole_step.push_back(r.whole_step);
+    rezoned.push_back(r.rezoned);
     if (!r.converged) ++not_converged;
     skipped += r.skipped;
   }
@@ -380,18 +381,23 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
       {"steps", sim.steps()},
       {"frames", frame},
       {"frames_written", frame_writer != nullptr},
-      {"wall_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()},
+      {"wall_seconds",
+       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()},
       {"magnetic_ms", statistics(tm)},
       {"rigid_ms", statistics(tr)},
       {"iterations", statistics(iterations)},
       {"substeps", statistics(substeps)},  // one relaxation per substep
       {"sleeping", statistics(sleeping)},  // bodies asleep at a step's end (simulation.sleep)
-      {"held", statistics(held)},  // bodies held over a step's later substeps (magnetic_solve "moving")
+      // bodies held over a step's later substeps (magnetic_solve "moving")
+      {"held", statistics(held)},
       // free bodies that took the step whole (rigid_substeps "moving")
       {"whole_step", statistics(whole_step)},
+      // bodies whose refined contact zones moved to their contacts (solver.contact_refinement)
+      {"rezoned", statistics(rezoned)},
       {"steps_not_converged", not_converged},
       {"magnetic_steps_skipped", skipped},  // substeps, with solver.skip_unchanged
-      {"exact_solver_failures", sim.world().exact_solver_failures()},  // substeps QuickStep took instead
+      // substeps QuickStep took instead
+      {"exact_solver_failures", sim.world().exact_solver_failures()},
       {"outcomes", outcomes},
       {"notices", sim.notices()},  // as printed while running (Simulation::notices)
   };

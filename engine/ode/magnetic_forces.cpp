@@ -47,7 +47,8 @@ MagneticForces::MagneticForces(const RelaxOptions& options, std::unique_ptr<Magn
   state_ = make_state(model_, seed);
 }
 
-MagneticForces::MagneticForces(MagneticModel model, MagneticState state, const RelaxOptions& options,
+MagneticForces::MagneticForces(MagneticModel model, MagneticState state,
+                               const RelaxOptions& options,
                                std::unique_ptr<MagneticBackend> backend)
     : model_(std::move(model)),
       state_(std::move(state)),
@@ -56,7 +57,8 @@ MagneticForces::MagneticForces(MagneticModel model, MagneticState state, const R
       options_(options),
       reference_force_(bodies_.size()),
       reference_torque_(bodies_.size()),
-      reference_known_(bodies_.size(), 0) {}
+      reference_known_(bodies_.size(), 0),
+      refinements_(bodies_.size(), 0) {}
 
 int MagneticForces::body_index(int index, const char* call) const {
   if (index < 0 || index >= model_.body_count())
@@ -71,6 +73,12 @@ void MagneticForces::bind(int index, dBodyID body) {
   if (body) state_.pose[index] = ode_pose(body);
 }
 
+void MagneticForces::refine_body(int index, const std::vector<RefinedZone>& zones) {
+  const MagneticBody old_body = model_.refine_body(body_index(index, "refine_body"), zones);
+  transfer_refined_state(model_, index, old_body, state_);
+  ++refinements_[index];
+}
+
 int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& material,
                            double cell_size, const std::string& name) {
   const int index = model_.add_body(name.empty() ? "body" + std::to_string(model_.body_count()) : name,
@@ -80,6 +88,7 @@ int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& mat
   reference_force_.emplace_back();
   reference_torque_.emplace_back();
   reference_known_.push_back(0);
+  refinements_.push_back(0);
   if (body) state_.pose[index] = ode_pose(body);
   return index;
 }
@@ -116,6 +125,7 @@ SavedMagneticState MagneticForces::save_state() const {
   saved.state = state_;
   saved.report = report_;
   count_cells(model_, saved.body_cells, saved.body_moments);
+  saved.body_refinements = refinements_;
   return saved;
 }
 
@@ -132,6 +142,11 @@ void MagneticForces::restore_state(const SavedMagneticState& saved) {
                                   model_.body(static_cast<int>(b)).name + "\" has " + std::to_string(cells[b]) +
                                   " cells and " + std::to_string(moments[b]) + " moments, the saved state " +
                                   std::to_string(saved.body_cells[b]) + " and " + std::to_string(saved.body_moments[b]));
+  for (size_t b = 0; b < cells.size() && saved.body_refinements.size() == cells.size(); ++b)
+    if (saved.body_refinements[b] != refinements_[b])
+      throw std::invalid_argument(
+          where + "body " + std::to_string(b) + " \"" + model_.body(static_cast<int>(b)).name +
+          "\" got new refined zones (refine_body) since the state was saved");
   // The state's own arrays (a saved state edited by hand).
   const MagneticState& s = saved.state;
   const size_t nb = cells.size(), nc = static_cast<size_t>(model_.cell_count()),

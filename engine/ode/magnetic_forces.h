@@ -38,6 +38,7 @@ struct SavedMagneticState {
   RelaxReport report;                // last_report() when saved
   std::vector<int> body_cells;       // per body: cells
   std::vector<int> body_moments;     // per body: soft moments
+  std::vector<int> body_refinements;  // per body: refine_body calls before the save
 };
 
 class MagneticForces : public ForceAccumulator {
@@ -137,6 +138,14 @@ class MagneticForces : public ForceAccumulator {
   Vec3 force(int index) const { return state_.force[body_index(index, "force")]; }                  // N, world
   Vec3 torque(int index) const { return state_.torque[body_index(index, "torque")]; }                // N m, about the CoM
 
+  // Gives a body new refined contact zones (MagneticModel::refine_body,
+  // docs/model.md "Refined contact zones"; none: its plain cells again): its
+  // cells are built anew and take the magnetization the old cells held there
+  // (transfer_refined_state); the next compute() relaxes. A state saved
+  // before no longer restores (restore_state refuses it). Throws std::out_of_range on a bad index
+  // and std::invalid_argument, changing nothing, for zones add_body refuses.
+  void refine_body(int index, const std::vector<RefinedZone>& zones);
+
   // Saving and restoring the magnetic state (docs/embedding.md "Saving and
   // restoring"): every cell's moments and magnetization, the warm-start and
   // skip data, poses, forces, active flags, magnetization scales, the
@@ -173,6 +182,7 @@ class MagneticForces : public ForceAccumulator {
   // Per body: F_0, T_0 of the wake-up rule (add_forces), and whether set.
   std::vector<Vec3> reference_force_, reference_torque_;
   std::vector<uint8_t> reference_known_;
+  std::vector<int> refinements_;  // per body: refine_body calls (save_state, restore_state)
 };
 
 // Pose of an ODE body as a magnetics BodyPose.

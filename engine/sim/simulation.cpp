@@ -72,7 +72,7 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
   // (build_magnetic_system), then tied to the ODE bodies.
   MagneticSystem ms = build_magnetic_system(scene_);
   contact_zones_ = std::move(ms.contact_zones);
-  contact_left_zones_.assign(scene_.bodies.size(), 0);
+  contact_zones_failed_.assign(scene_.bodies.size(), 0);
   magnetics_ = std::make_unique<MagneticForces>(
       std::move(ms.model), std::move(ms.state), scene_.solver.relax,
       backend ? std::move(backend) : make_cpu_backend(scene_.solver.threads));
@@ -343,30 +343,46 @@ void Simulation::step() {
   time_ += dt;
   ++steps_;
   outcomes_.sample(scene_, time_, dt, *world_, *magnetics_);
-  if (scene_.solver.contact_refinement) check_contact_zones();
+  if (scene_.solver.contact_refinement) follow_contact_zones(records_.back());
   records_.back().wall_ms = elapsed_ms(started);
 }
 
-void Simulation::check_contact_zones() {
-  const MagneticState& state = magnetics_->state();
+void Simulation::follow_contact_zones(StepRecord& record) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // The poses at the step's end (the magnetic state holds the last substep's).
+  std::vector<BodyPose> poses(scene_.bodies.size());
+  for (size_t b = 0; b < poses.size(); ++b) poses[b] = world_->pose(static_cast<int>(b));
+  const std::vector<uint8_t>& active = magnetics_->state().active;
   for (size_t b = 0; b < scene_.bodies.size(); ++b) {
-    if (contact_left_zones_[b] || !state.active[b]) continue;
-    for (const Vec3& point : contact_points(scene_, state.pose, state.active, static_cast<int>(b))) {
-      bool covered = false;
+    if (contact_zones_failed_[b] || !active[b]) continue;
+    const std::vector<Vec3> points = contact_points(scene_, poses, active, static_cast<int>(b));
+    const double h = scene_.body_cell_size(static_cast<int>(b));
+    bool covered = true;
+    for (const Vec3& point : points) {
+      bool near_zone = false;
       for (const RefinedZone& zone : contact_zones_[b])
-        covered = covered || norm(point - zone.point) <= zone.radii.back();
-      if (covered) continue;
-      contact_left_zones_[b] = 1;
+        near_zone = near_zone || norm(point - zone.point) <= kContactZoneFollowDistance * h;
+      covered = covered && near_zone;
+    }
+    if (covered) continue;
+    // The zones the scene would place at these poses (scene_contact_zones).
+    std::vector<RefinedZone> zones;
+    for (const Vec3& point : points) zones.push_back({point, default_refinement_radii(h)});
+    try {
+      magnetics_->refine_body(static_cast<int>(b), zones);
+      contact_zones_[b] = std::move(zones);
+      ++record.rezoned;
+    } catch (const std::invalid_argument& e) {  // more than kMaxRefinedCells cells
+      contact_zones_failed_[b] = 1;
       char t[32];
       std::snprintf(t, sizeof t, "%.4f", time_);
-      notices_.push_back(scene_.file + ": body '" + scene_.bodies[b].name + "' (bodies[" + std::to_string(b) +
-                         "]): at t = " + t +
-                         " s a contact lies outside its refined contact zones (solver.contact_refinement"
-                         " places them at the scene's poses), so its force there has the plain lattice's"
-                         " error");
-      break;
+      notices_.push_back(scene_.file + ": body '" + scene_.bodies[b].name + "' (bodies[" +
+                         std::to_string(b) + "]): at t = " + t +
+                         " s its refined contact zones could not follow its contacts (" + e.what() +
+                         "), so its force there has the plain lattice's error");
     }
   }
+  if (record.rezoned > 0) record.magnetic_ms += elapsed_ms(t0);
 }
 
 void Simulation::advance_to(double t) {

@@ -34,6 +34,10 @@ struct StepRecord {
   int skipped = 0;           // substeps whose magnetic step was skipped (solver.skip_unchanged)
   int held = 0;              // magnetic_solve "moving": induced bodies held, summed over the later substeps
   int whole_step = 0;        // rigid_substeps "moving": free bodies that took the step whole
+  // solver.contact_refinement: bodies whose refined contact zones moved to
+  // their contacts after the step (Simulation::follow_contact_zones); the
+  // time it took counts in magnetic_ms.
+  int rezoned = 0;
   bool converged = true;
   double residual = 0.0;
   int sleeping = 0;          // bodies asleep at the step's end (SleepSettings)
@@ -78,8 +82,8 @@ class Simulation {
   // steps from 1 and T the end of the substep.
   std::string non_finite_message() const;
   // Notices for the user, in the order they arose (odemag run prints each
-  // once): with solver.contact_refinement, the first time a refined ball's
-  // contact lies outside its zones (check_contact_zones).
+  // once): with solver.contact_refinement, a lattice ball whose zones could
+  // not follow its contacts (follow_contact_zones).
   const std::vector<std::string>& notices() const { return notices_; }
 
  private:
@@ -136,14 +140,16 @@ class Simulation {
   // and the state it ends the step in.
   std::vector<uint8_t> whole_;
   std::vector<RigidWorld::Motion> whole_end_;
-  // solver.contact_refinement: after a step, a notice, once per body, when a
-  // lattice ball's contact point (contact_points at the current poses) lies
-  // farther than its zones' finest radius from every zone point: the zones
-  // stay where the scene placed them (docs/model.md "Refined contact
-  // zones"), so such a contact has the plain lattice's error.
-  void check_contact_zones();
+  // solver.contact_refinement: after a step, every lattice ball with a
+  // contact point (contact_points at the step's end poses) farther than
+  // kContactZoneFollowDistance h from every zone point gets new zones at its
+  // contact points (MagneticForces::refine_body), the zones the scene would
+  // place at these poses (docs/model.md "Refined contact zones"). A body
+  // whose zones cannot be built (beyond kMaxRefinedCells) keeps its cells
+  // and gets one notice.
+  void follow_contact_zones(StepRecord& record);
   std::vector<std::vector<RefinedZone>> contact_zones_;
-  std::vector<uint8_t> contact_left_zones_;  // by body: its notice was given
+  std::vector<uint8_t> contact_zones_failed_;  // by body: its notice was given
   std::vector<std::string> notices_;
   // The first body found non-finite (-1 while none), its step and time.
   int non_finite_body_ = -1;

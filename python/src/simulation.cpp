@@ -178,6 +178,7 @@ class PySimulation {
     d["sleeping"] = copied_array<int>(column(&StepRecord::sleeping));
     d["held"] = copied_array<int>(column(&StepRecord::held));
     d["whole_step"] = copied_array<int>(column(&StepRecord::whole_step));
+    d["rezoned"] = copied_array<int>(column(&StepRecord::rezoned));
     return d;
   }
 
