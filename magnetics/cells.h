@@ -125,7 +125,7 @@ inline constexpr size_t kMaxRefinementLevels = 4;
 // tensors take 48 n^2 bytes (770 MB at 4000 cells).
 inline constexpr int kMaxRefinedCells = 4000;
 // A refined body of at most this many cells takes the exact boundary
-// correction on its sub-cubes where its operator stays positive definite
+// correction on its partial sub-cubes where its operator stays positive definite
 // (checked by a Cholesky of its 3 n unknowns when it is built); a larger
 // one caps every cell (docs/model.md "Refined contact zones").
 inline constexpr int kMaxExactSubCubeCells = 2000;

@@ -175,9 +175,9 @@ double local_gamma(const MagneticBody& body) {
 // So a lattice ball in a uniform field takes the continuum sphere's moment (its
 // solution is uniform), and the local part carries the boundary correction to
 // non-uniform fields (a chi = 1000 ball next to a point dipole, docs/model.md).
-// With exact_sub_cubes a refined body's sub-cubes take the exact local part,
-// which the proof above does not cover (MagneticModel::add_body checks the
-// operator and decides).
+// With exact_sub_cubes a refined body's partial sub-cubes take the exact
+// local part, which the proof above does not cover (MagneticModel::add_body
+// checks the operator and decides).
 void build_boundary_correction(MagneticBody& body, bool exact_sub_cubes = false) {
   const CellSet& cells = body.cells;
   const int count = cells.size();
@@ -199,11 +199,16 @@ void build_boundary_correction(MagneticBody& body, bool exact_sub_cubes = false)
     }
     const Eigen::Matrix3d S = symmetric_matrix(sum), Nbar = symmetric_matrix(nbar), I = Eigen::Matrix3d::Identity();
     const Vec3 half = cells.cube_half(i);
-    const double cap = (1.0 - cells.volumes[i] / (8.0 * half.x * half.y * half.z)) / 3.0;  // (1 - w_i) / 3
-    // With exact_sub_cubes, a refined body's sub-cubes (edge h/2 and smaller)
-    // take the exact local part: the cap there biased the contact force by +4%
-    // to +6% (docs/model.md "Refined contact zones"); the cells of edge h keep it.
-    const bool sub_cube = exact_sub_cubes && refined && half.x < 0.375 * cells.spacing;
+    const double w = cells.volumes[i] / (8.0 * half.x * half.y * half.z);
+    const double cap = (1.0 - w) / 3.0;
+    // With exact_sub_cubes, a refined body's partial sub-cubes (edge h/2 and
+    // smaller, w_i < 1) take the exact local part: the cap there biased the
+    // contact force by +4% to +6% (docs/model.md "Refined contact zones").
+    // The cells of edge h keep the cap, and so do whole sub-cubes, whose
+    // bound is 0: their exact part took a swirl of magnetization about the
+    // contact axis below zero energy.
+    const bool sub_cube =
+        exact_sub_cubes && refined && half.x < 0.375 * cells.spacing && cap > 1e-9;
     const Eigen::Matrix3d K = sub_cube ? Eigen::Matrix3d(I / 3.0 + S - Nbar)
                                        : capped_boundary_correction(I / 3.0 + S - Nbar, cap);
     const Eigen::Matrix3d Pi = gamma * I - K + S, beta = (gamma - 1.0 / 3.0) * I + Nbar;
@@ -309,13 +314,16 @@ MagneticBody MagneticModel::make_body(const std::string& name, const Shape& shap
   } else if (body.responsive() && body.cells.refined) {
     build_refined_pair_tensors(body);
     if (body.recoil >= 0.0) {
-      // The sub-cubes' exact local part is not bounded as the cap is: keep it
-      // only where the body's operator stays positive definite (checked up to
-      // kMaxExactSubCubeCells cells), else cap every cell (docs/model.md
-      // "Refined contact zones").
-      const bool exact = body.cell_count() <= kMaxExactSubCubeCells;
-      build_boundary_correction(body, exact);
-      if (exact && !body_operator_positive_definite(body, local_gamma(body))) build_boundary_correction(body);
+      // The partial sub-cubes' exact local part is not bounded as the cap
+      // is: keep it only where the body's operator stays positive definite
+      // (checked up to kMaxExactSubCubeCells cells), else cap every cell
+      // (docs/model.md "Refined contact zones").
+      body.exact_sub_cubes = body.cell_count() <= kMaxExactSubCubeCells;
+      build_boundary_correction(body, body.exact_sub_cubes);
+      if (body.exact_sub_cubes && !body_operator_positive_definite(body, local_gamma(body))) {
+        body.exact_sub_cubes = false;
+        build_boundary_correction(body);
+      }
     }
     body.response = build_body_response(body);
   } else if (body.responsive() && body.cell_count() > 1) {

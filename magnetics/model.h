@@ -71,6 +71,10 @@ struct MagneticBody {
   std::vector<double> self_tensors;
   std::vector<double> uniform_tensors;
   Mat3 uniform_inverse[2];
+  // Bodies of refined zones: whether their partial sub-cubes took the exact
+  // local part (add_body's positivity check passed), else every cell is
+  // capped (docs/model.md "Refined contact zones").
+  bool exact_sub_cubes = false;
   // The factor of the body's linear self-response (magnetics/body_response.h),
   // the outer loop's block preconditioner; null for bodies that take none.
   std::shared_ptr<const BodyResponseFactor> response;

@@ -67,9 +67,9 @@ inline constexpr double kContactRefinementGap = 0.5;
 // A run moves a ball's zones (Simulation::follow_contact_zones) once one of
 // its contact points lies farther than this many cell sizes h from every
 // zone point. Two balls 0.05 R apart at R/h 4.5: zones left 0.39 h and
-// 0.79 h behind the contact gave force errors of +0.4% and +0.9% (moved:
-// -1.0%, -1.6%), 2.4 h and 3.5 h behind +6.3% and +25.7% (moved: +0.8%,
-// +1.0%) (docs/validation.md section 5, refined_contact --rolling).
+// 0.79 h behind the contact gave force errors of +1.1% and +1.2% (moved:
+// +0.2%, -1.6%), 2.4 h and 3.5 h behind +8.0% and +25.9% (moved: +1.0%,
+// +0.8%) (docs/validation.md section 5, refined_contact --rolling).
 inline constexpr double kContactZoneFollowDistance = 0.5;
 
 // The body's pose in the scene description.

@@ -168,8 +168,9 @@ TEST_F(Cli, GradedCellsKeyRefinesASoftCube) {
 // 4.5) 0.05 R apart along (1, 2, 2) / 3 in a field along that line get a
 // refined zone each at their nearest points (docs/model.md "Refined contact
 // zones"); the force on the upper ball is within 3% of the exact two-centre
-// series (measured +1.3%; without the key -26%); a third ball 20 R away
-// takes no zone and changes the force by about 1e-4. The CUDA backend is
+// series (-0.4% in benchmarks/results/refined_contact.md; without the key
+// -26%); a third ball 20 R away takes no zone and changes the force by
+// about 1e-4. The CUDA backend is
 // refused with exit 2, and so are a key that is not a bool and zones that
 // would give a ball more than 4000 cells.
 TEST_F(Cli, ContactRefinementKeyRefinesTouchingLatticeBalls) {
