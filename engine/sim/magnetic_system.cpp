@@ -16,14 +16,19 @@ BodyPose scene_pose(const BodyDescription& body) {
   return pose;
 }
 
+bool takes_contact_zones(const SceneDescription& scene, int b) {
+  const BodyDescription& body = scene.bodies[b];
+  const auto material = scene.materials.find(body.material);
+  return std::holds_alternative<Sphere>(body.shape) && material != scene.materials.end() &&
+         has_positive_susceptibility(material->second) &&
+         uses_volume_shares(body.shape, scene.body_cell_size(b));
+}
+
 std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vector<BodyPose>& poses,
                                  const std::vector<uint8_t>& active, int b) {
+  if (!takes_contact_zones(scene, b)) return {};
   const BodyDescription& body = scene.bodies[b];
   const auto* ball = std::get_if<Sphere>(&body.shape);
-  const auto material = scene.materials.find(body.material);
-  if (!ball || material == scene.materials.end() || !has_positive_susceptibility(material->second) ||
-      !uses_volume_shares(body.shape, scene.body_cell_size(b)))
-    return {};
   const BodyPose& pose = poses[b];
   std::vector<Vec3> points;
   for (size_t o = 0; o < scene.bodies.size(); ++o) {
@@ -134,8 +139,10 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene) {
 
 std::string cpu_only_feature(const SceneDescription& scene) {
   if (scene.solver.graded_cells) return "graded cells (solver.graded_cells)";
-  for (const std::vector<RefinedZone>& zones : scene_contact_zones(scene))
-    if (!zones.empty()) return "refined contact zones (solver.contact_refinement)";
+  // A lattice ball that may get zones, now or when a run moves them.
+  for (size_t b = 0; scene.solver.contact_refinement && b < scene.bodies.size(); ++b)
+    if (takes_contact_zones(scene, static_cast<int>(b)))
+      return "refined contact zones (solver.contact_refinement)";
   for (const auto& [name, material] : scene.materials)
     if (const auto* soft = std::get_if<SoftMaterial>(&material); soft && !soft->bh_curve.empty())
       return "a B-H curve (materials." + name + ".bh_curve)";

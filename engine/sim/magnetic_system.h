@@ -55,6 +55,11 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene);
 // zones stay where they are in the body frame). Every list is empty otherwise.
 std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene);
 
+// Whether body b may get refined contact zones: a lattice ball (a sphere of
+// volume-share cells) of a material with positive susceptibility. Does not
+// look at solver.contact_refinement.
+bool takes_contact_zones(const SceneDescription& scene, int b);
+
 // The contact points of scene_contact_zones at the given poses (indexed as
 // scene.bodies): ball b's surface points, body frame, towards each other
 // magnetized or soft body (active, when active is not empty) whose nearest
@@ -85,7 +90,8 @@ std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threa
 
 // "" or the first of the scene's CPU-only features, as a user reads it: graded
 // cells (solver.graded_cells), refined contact zones (solver.contact_refinement
-// with a zone), a B-H curve (materials.NAME.bh_curve).
+// with a body that takes_contact_zones: a run may give it zones later), a
+// B-H curve (materials.NAME.bh_curve).
 std::string cpu_only_feature(const SceneDescription& scene);
 
 }  // namespace odemag
