@@ -1,5 +1,6 @@
 #include "magnetics/state.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 
@@ -77,10 +78,10 @@ std::vector<int> source_cells(const CellSet& old_cells, const CellSet& cells) {
 // each new cell i, the width entries of old cell source[i].
 template <class T>
 std::vector<T> remapped(const std::vector<T>& v, size_t first, size_t width, size_t old_count,
-                        const std::vector<int>& source, T cleared = T{}, bool clear = false) {
+                        const std::vector<int>& source) {
   std::vector<T> out(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(first));
   for (const int s : source)
-    for (size_t k = 0; k < width; ++k) out.push_back(clear ? cleared : v[first + s * width + k]);
+    for (size_t k = 0; k < width; ++k) out.push_back(v[first + s * width + k]);
   out.insert(out.end(), v.begin() + static_cast<std::ptrdiff_t>(first + old_count * width),
              v.end());
   return out;
@@ -97,10 +98,15 @@ void transfer_refined_state(const MagneticModel& model, int b, const MagneticBod
   state.cell_position = remapped(state.cell_position, first, 1, old_count, source);
   state.magnetization = remapped(state.magnetization, first, 1, old_count, source);
   state.applied_field = remapped(state.applied_field, first, 1, old_count, source);
-  state.relaxation_change =
-      remapped(state.relaxation_change, first, 1, old_count, source, Vec3{}, true);
+  // The warm-start changes of body b's cells are cleared (the old cells' do
+  // not predict the new ones'); the arrays only take the new count.
+  state.relaxation_change = remapped(state.relaxation_change, first, 1, old_count, source);
   state.previous_relaxation_change =
-      remapped(state.previous_relaxation_change, first, 1, old_count, source, Vec3{}, true);
+      remapped(state.previous_relaxation_change, first, 1, old_count, source);
+  std::fill_n(state.relaxation_change.begin() + static_cast<std::ptrdiff_t>(first), source.size(),
+              Vec3{});
+  std::fill_n(state.previous_relaxation_change.begin() + static_cast<std::ptrdiff_t>(first),
+              source.size(), Vec3{});
   state.llg_history = remapped(state.llg_history, first, 1, old_count, source);
   state.noise_counter = remapped(state.noise_counter, first, 1, old_count, source);
   if (body.kind == CellKind::soft && body.cell_count() > 0) {

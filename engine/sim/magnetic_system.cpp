@@ -52,16 +52,23 @@ std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vecto
   return points;
 }
 
+std::vector<RefinedZone> contact_zones(const SceneDescription& scene,
+                                       const std::vector<BodyPose>& poses,
+                                       const std::vector<uint8_t>& active, int b) {
+  const double h = scene.body_cell_size(b);
+  std::vector<RefinedZone> zones;
+  for (const Vec3& point : contact_points(scene, poses, active, b))
+    zones.push_back({point, default_refinement_radii(h)});
+  return zones;
+}
+
 std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene) {
   std::vector<std::vector<RefinedZone>> zones(scene.bodies.size());
   if (!scene.solver.contact_refinement) return zones;
   std::vector<BodyPose> poses;
   for (const BodyDescription& body : scene.bodies) poses.push_back(scene_pose(body));
-  for (size_t b = 0; b < scene.bodies.size(); ++b) {
-    const double h = scene.body_cell_size(static_cast<int>(b));
-    for (const Vec3& point : contact_points(scene, poses, {}, static_cast<int>(b)))
-      zones[b].push_back({point, default_refinement_radii(h)});
-  }
+  for (size_t b = 0; b < scene.bodies.size(); ++b)
+    zones[b] = contact_zones(scene, poses, {}, static_cast<int>(b));
   return zones;
 }
 

@@ -69,6 +69,13 @@ bool takes_contact_zones(const SceneDescription& scene, int b);
 std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vector<BodyPose>& poses,
                                  const std::vector<uint8_t>& active, int b);
 inline constexpr double kContactRefinementGap = 0.5;
+
+// Body b's zones at the given poses: one at each of its contact_points, with
+// default_refinement_radii. scene_contact_zones is this at the scene's
+// poses; Simulation::follow_contact_zones at a step's end.
+std::vector<RefinedZone> contact_zones(const SceneDescription& scene,
+                                       const std::vector<BodyPose>& poses,
+                                       const std::vector<uint8_t>& active, int b);
 // A run moves a ball's zones (Simulation::follow_contact_zones) once one of
 // its contact points lies farther than this many cell sizes h from every
 // zone point. Two balls 0.05 R apart at R/h 4.5: zones left 0.39 h and

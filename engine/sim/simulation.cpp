@@ -355,19 +355,17 @@ void Simulation::follow_contact_zones(StepRecord& record) {
   const std::vector<uint8_t>& active = magnetics_->state().active;
   for (size_t b = 0; b < scene_.bodies.size(); ++b) {
     if (contact_zones_failed_[b] || !active[b]) continue;
-    const std::vector<Vec3> points = contact_points(scene_, poses, active, static_cast<int>(b));
+    // The zones the scene would place at these poses (scene_contact_zones).
+    std::vector<RefinedZone> zones = contact_zones(scene_, poses, active, static_cast<int>(b));
     const double h = scene_.body_cell_size(static_cast<int>(b));
     bool covered = true;
-    for (const Vec3& point : points) {
+    for (const RefinedZone& wanted : zones) {
       bool near_zone = false;
       for (const RefinedZone& zone : contact_zones_[b])
-        near_zone = near_zone || norm(point - zone.point) <= kContactZoneFollowDistance * h;
+        near_zone = near_zone || norm(wanted.point - zone.point) <= kContactZoneFollowDistance * h;
       covered = covered && near_zone;
     }
     if (covered) continue;
-    // The zones the scene would place at these poses (scene_contact_zones).
-    std::vector<RefinedZone> zones;
-    for (const Vec3& point : points) zones.push_back({point, default_refinement_radii(h)});
     try {
       magnetics_->refine_body(static_cast<int>(b), zones);
       contact_zones_[b] = std::move(zones);
