@@ -149,8 +149,15 @@ for scene in scenes:
     r["before_tr_mean_ms"] = b["rigid_ms"].get("mean") if b else None
     r["before_iterations_mean"] = b["iterations"].get("mean") if b else None
     r["before_substeps_mean"] = b["substeps"].get("mean") if b else None
+    # The scene's outcome numbers (summary.json "outcomes"), for the tables only.
+    r["_outcomes"] = s.get("outcomes", {})
+    r["_before_outcomes"] = b.get("outcomes", {}) if b else {}
     r["ratio_tm_before_over_ours"] = ratio(r["before_tm_mean_ms"], tm.get("mean"))
     r["ratio_tr_before_over_ours"] = ratio(r["before_tr_mean_ms"], tr.get("mean"))
+
+def outcomes(o):
+    """summary.json's outcome numbers as "name value, ..." (a table cell)."""
+    return ", ".join(f"{k} {fmt(v)}" for k, v in o.items())
 
 def fmt(v, digits=3):
     if v is None:
@@ -186,13 +193,14 @@ with open(os.path.join(out, "paper_scenes.md"), "w") as f:
         f.write(f"\nBefore and after, each scene run with the earlier program ({before}) just before the "
                 "current one: means per rigid step in ms; ratio = before / after (above 1: faster now).\n\n")
         f.write("| scene | T_m before | T_m after | ratio T_m | T_r before | T_r after | ratio T_r | "
-                "iterations before | iterations after | substeps before | substeps after |\n")
-        f.write("|---|---|---|---|---|---|---|---|---|---|---|\n")
+                "iterations before | iterations after | substeps before | substeps after | outcomes before | outcomes after |\n")
+        f.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
         for r in rows:
             f.write("| " + " | ".join([
                 r["_title"], fmt(r["before_tm_mean_ms"]), fmt(r["tm_mean_ms"]), fmt(r["ratio_tm_before_over_ours"], 2),
                 fmt(r["before_tr_mean_ms"]), fmt(r["tr_mean_ms"]), fmt(r["ratio_tr_before_over_ours"], 2),
                 fmt(r["before_iterations_mean"]), fmt(r["iterations_mean"]),
-                fmt(r["before_substeps_mean"], 3), fmt(r["substeps_mean"], 3)]) + " |\n")
+                fmt(r["before_substeps_mean"], 3), fmt(r["substeps_mean"], 3),
+                outcomes(r["_before_outcomes"]), outcomes(r["_outcomes"])]) + " |\n")
 print(open(os.path.join(out, "paper_scenes.md")).read())
 EOF

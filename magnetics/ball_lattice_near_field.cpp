@@ -79,16 +79,20 @@
 // Carried-over pairs: a ball's pairs with a lattice body (PairGroup) are kept
 // from build to build. While the ball's centre stays within kReuseTolerance R
 // of the point q0 where they were evaluated (in the body's frame, the frame
-// not turned), each pair is carried to its new offset r = r0 + dr to first
+// not turned, and none of the pairs in the inner fade w_in < 1: overlapping
+// bodies are evaluated every time), each pair is carried to its new offset r = r0 + dr to first
 // order, w = w0 + grad w . dr and T_c = T_c0 + (dT_c/dr) dr, with the point
 // dipole's T(r; s) exact, and the gradients as at r0. Since T_c varies on the
 // scale of delta >= kFadeEnd R, the fields (and the energy) are off by
-// O((dr / delta)^2) <= ~1e-8 and the forces by O(dr / delta) <= ~1e-4 of the
-// correction (measured at 0.9 tolerance: 1.0e-10 and 1.2e-5 of a touching
-// ball's field and force): far below the near field's own error (~1e-3). A
+// O((dr / delta)^2) <= ~1e-6 and the forces by O(dr / delta) <= ~1e-3 of the
+// correction (measured at 0.9 tolerance: 1.0e-8 and 1.2e-4 of a touching
+// ball's field and force): below the near field's own error (~1e-3). A
 // ball that hangs or rests against a magnet moves nanometres per substep in its
 // frame, so most of its pairs skip the corner terms (ball chain: T_m median
-// 0.050 -> 0.040 ms from 1e-5 to 1e-4 R; docs/benchmarks.md 1f).
+// 0.050 -> 0.040 ms from 1e-5 to 1e-4 R; docs/benchmarks.md 1f); the balls
+// that hang from the lifted crane, jostled by their neighbours, move 1e-4 to
+// 1e-3 R per substep (from 1e-4 to 1e-3 R the crane's ball-lattice pairs
+// evaluated fell 2.5 times; docs/benchmarks.md 4p).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
@@ -115,7 +119,7 @@ constexpr double kFadeStart = 0.75;  // above: full correction
 constexpr double kMinCoupleInertia = 0.1;
 // A ball's pairs are carried over from the last evaluation while its centre
 // stays within this many R of where they were evaluated (lattice body frame).
-constexpr double kReuseTolerance = 1e-4;
+constexpr double kReuseTolerance = 1e-3;
 
 // C2 step S(t) = t^3 (10 - 15 t + 6 t^2) on [0, 1], clamped; slope dS/dt.
 double quintic_step(double t, double& slope) {
@@ -403,11 +407,14 @@ struct PairCoupling {
 };
 
 // A ball's pairs with one lattice body, kept from build to build: while the
-// ball's centre stays within kReuseTolerance R of q0 in the body's frame and
-// the frame has not turned, the pairs are those evaluated at q0, carried to
-// the new offset to first order (header comment).
+// ball's centre stays within kReuseTolerance R of q0 in the body's frame, the
+// frame has not turned and no pair is in the inner fade, the pairs are those
+// evaluated at q0, carried to the new offset to first order (header comment).
 struct PairGroup {
   bool valid = false;
+  // A pair in the inner fade (an overlapping ball, where w_in and T_c vary
+  // on the scale of 0.25 R): evaluated afresh at every build.
+  bool in_fade = false;
   Vec3 q0;  // ball centre in the lattice body's frame at the evaluation
   Mat3 R0;  // the lattice body's rotation then
   std::vector<BallCellPair> pairs;
@@ -461,7 +468,8 @@ class BallLatticeNearField final : public NearFieldTerm {
         const std::size_t gi = static_cast<std::size_t>(ball.body) * cached_.size() + li;
         PairGroup& group = groups_[gi];
         active_groups_.push_back(gi);
-        if (group.valid && same(R_X, group.R0) && norm(q - group.q0) <= kReuseTolerance * ball.radius) {
+        if (group.valid && !group.in_fade && same(R_X, group.R0) &&
+            norm(q - group.q0) <= kReuseTolerance * ball.radius) {
           for (BallCellPair& p : group.pairs) {
             p.ball = bi;
             p.r = xb - state.cell_position[p.c];
@@ -471,6 +479,7 @@ class BallLatticeNearField final : public NearFieldTerm {
           continue;
         }
         group.valid = true;
+        group.in_fade = false;
         group.q0 = q;
         group.R0 = R_X;
         group.pairs.clear();
@@ -503,6 +512,7 @@ class BallLatticeNearField final : public NearFieldTerm {
           p.volume_c = model.cell_volume(p.c);
           p.r0 = p.r;
           p.base = p.geometry;
+          if (p.geometry.w_in < 1.0) group.in_fade = true;
           set_K(model, p);
           group.pairs.push_back(p);
         }

@@ -50,18 +50,20 @@
 // unsaturated, nothing once the sphere is. A heuristic between two exact
 // limits (docs/model.md); forces take it as fixed (no gradient of the factor).
 //
-// Carried-over pairs: a pair's K, dK/dd and contact coefficients are kept
-// from build to build; while its centre distance stays within
-// kReuseTolerance min(d0 - (R_a + R_b), R_a + R_b) of the distance d0 where
-// they were evaluated, K is carried to first order, K(d) = K(d0) + dK/dd(d0)
-// (d - d0), the rest kept, and the direction u is the new one. The functions
-// vary on the scale of the gap d - (R_a + R_b) near contact (they grow like
-// its logarithm for high chi) and of R_a + R_b beyond, so the fields are off
-// by O(kReuseTolerance^2) and the forces by O(kReuseTolerance) of the
-// correction (measured 2.5e-6 of a close pair's force at 0.9 of it;
-// docs/model.md "Carried-over pairs"); overlapping pairs are evaluated every
-// time. Balls resting in a heap or hanging together move by far less than
-// that between substeps.
+// Carried-over pairs: a pair's K with its first two derivatives in d, and
+// the contact coefficients with their slope, are kept from build to build;
+// while its centre distance stays within kReuseTolerance min(d0 - (R_a +
+// R_b), R_a + R_b) of the distance d0 where they were evaluated, K is carried
+// to second order, K(d) = K(d0) + K'(d0) (d - d0) + K''(d0) (d - d0)^2 / 2,
+// dK/dd to first, the contact coefficients to first, and the direction u is
+// the new one. The functions vary on the scale of the gap d - (R_a + R_b)
+// near contact (they grow like its logarithm for high chi) and of R_a + R_b
+// beyond, so the fields are off by O(kReuseTolerance^3) and the forces by
+// O(kReuseTolerance^2) of the correction (docs/model.md "Carried-over
+// pairs"); overlapping pairs are evaluated every time. Balls resting in a
+// heap, hanging together, or pushed about by a moving body change their
+// distances by less than that between substeps. When the close pairs are
+// those of the last build (the usual case) they are updated in place.
 //
 // Pairs, not clusters: the higher orders of a sphere excited by two
 // neighbours are the sum of the two pairs' (linear), but the cross terms
@@ -92,7 +94,10 @@ constexpr double kInsideFade = 0.1;     // overlap (of R_a + R_b) over which K f
 constexpr int kKnots = 160;             // spline knots on [1, kCutoff]
 // A pair's coefficients are carried over from its last evaluation at d0
 // while |d - d0| <= kReuseTolerance min(d0 - (R_a + R_b), R_a + R_b) (SphereNearField::build).
-constexpr double kReuseTolerance = 1e-5;
+constexpr double kReuseTolerance = 1e-2;
+// The pair list holds the pairs within (kCutoff + kListMargin) (R_a + R_b)
+// and is made anew once a sphere has moved kListMargin R_min.
+constexpr double kListMargin = 0.2;
 
 // The susceptibility of a sphere without induced higher orders (a rigid
 // magnet, a one-cell box or cylinder); linear spheres have chi >= -1 (below 0:
@@ -245,21 +250,26 @@ class PairTable {
   }
 
   // Contact-point magnetization coefficients (1/m^3) at centre distance d:
-  // M_hi along u at a = c[0] (u.p_a) + c[1] (u.p_b), at b = c[2] (u.p_a) + c[3] (u.p_b).
-  void contact(double d, double reach, double c[4]) const {
+  // M_hi along u at a = c[0] (u.p_a) + c[1] (u.p_b), at b = c[2] (u.p_a) +
+  // c[3] (u.p_b); dc their slope in d (1/m^4, 0 where d / reach is clamped).
+  void contact(double d, double reach, double c[4], double dc[4]) const {
     const double x = std::clamp(d / reach, 1.0, kCutoff), xr = x * reach, inv_d3 = 1.0 / (xr * xr * xr);
+    const bool clamped = x != d / reach;
     const Weights w = weights(x);
     for (int s = 0; s < 4; ++s) {
-      double v, slope;
-      series_at(w, 6 + s, v, slope);
+      double v, slope, curvature;
+      series_at(w, 6 + s, v, slope, curvature);
       c[s] = v * inv_d3;
+      dc[s] = clamped ? 0.0 : slope * inv_d3 / reach - 3.0 * c[s] / xr;
     }
   }
-  // K (1/m^3) and dK/dd (1/m^4) at centre distance d of a pair with
-  // reach = R_a + R_b: k d^3 from the splines with the taper; zero beyond
-  // the cutoff and deep inside contact.
-  void eval(double d, double reach, double K[6], double dK[6]) const {
+  // K (1/m^3), dK/dd (1/m^4) and d2K/dd2 (1/m^5) at centre distance d of a
+  // pair with reach = R_a + R_b: k d^3 from the splines with the taper; zero
+  // beyond the cutoff and deep inside contact (the fade below contact has
+  // d2K = 0: overlapping pairs are not carried over).
+  void eval(double d, double reach, double K[6], double dK[6], double d2K[6]) const {
     const double x = d / reach;
+    std::fill(d2K, d2K + 6, 0.0);
     if (x >= kCutoff) {
       std::fill(K, K + 6, 0.0), std::fill(dK, dK + 6, 0.0);
       return;
@@ -269,8 +279,8 @@ class PairTable {
       // K and dK/dd at contact (forces continuous) over kInsideFade reach:
       // bounded, with a repulsive core, and nothing for deeper overlaps (a
       // constant continuation made overlapping chi = 100 balls unstable).
-      double K1[6], dK1[6];
-      eval(reach, reach, K1, dK1);
+      double K1[6], dK1[6], unused[6];
+      eval(reach, reach, K1, dK1, unused);
       const double h = kInsideFade * reach, t = (d - (reach - h)) / h;
       for (int s = 0; s < 6; ++s) {
         if (t <= 0.0) {
@@ -282,21 +292,29 @@ class PairTable {
       }
       return;
     }
-    // Taper w(x): 1 below kTaperStart, 0 at kCutoff, C^2 (smootherstep).
-    double w = 1.0, dw = 0.0;
+    // Taper w(x) = 1 - S(u): 1 below kTaperStart, 0 at kCutoff, C^2
+    // (smootherstep S = u^3 (10 - 15 u + 6 u^2), S' = 30 u^2 (1 - u)^2,
+    // S'' = 60 u (1 - u) (1 - 2 u)); dw, d2w in x.
+    double w = 1.0, dw = 0.0, d2w = 0.0;
     if (x > kTaperStart) {
-      const double u = (x - kTaperStart) / (kCutoff - kTaperStart);
+      const double span = kCutoff - kTaperStart, u = (x - kTaperStart) / span;
       w = 1.0 - u * u * u * (10.0 - 15.0 * u + 6.0 * u * u);
-      dw = -30.0 * u * u * (1.0 - u) * (1.0 - u) / (kCutoff - kTaperStart);
+      dw = -30.0 * u * u * (1.0 - u) * (1.0 - u) / span;
+      d2w = -60.0 * u * (1.0 - u) * (1.0 - 2.0 * u) / (span * span);
     }
     const double inv_d = 1.0 / d, inv_d3 = inv_d * inv_d * inv_d, inv_reach_d3 = inv_d3 / reach;
     const Weights at = weights(x);
     for (int s = 0; s < 6; ++s) {
-      double k, dk;
-      series_at(at, s, k, dk);
-      // K = w k / d^3, d/dd = (w dk/dx + dw/dx k) / (reach d^3) - 3 w k / d^4.
+      double k, dk, d2k;
+      series_at(at, s, k, dk, d2k);
+      // K = f / d^3 with f = w k in x = d / reach:
+      // K' = f' / (reach d^3) - 3 K / d, K'' = f'' / (reach^2 d^3) - 6 f' / (reach d^4) + 12 K /
+      // d^2.
+      const double f1 = w * dk + dw * k, f2 = d2w * k + 2.0 * dw * dk + w * d2k;
       K[s] = w * k * inv_d3;
-      dK[s] = (w * dk + dw * k) * inv_reach_d3 - 3.0 * K[s] * inv_d;
+      dK[s] = f1 * inv_reach_d3 - 3.0 * K[s] * inv_d;
+      d2K[s] = (f2 * inv_reach_d3 / reach - 6.0 * f1 * inv_reach_d3 * inv_d) +
+               12.0 * K[s] * inv_d * inv_d;
     }
   }
 
@@ -325,13 +343,14 @@ class PairTable {
     w.b = (x - x_[i]) / w.h;
     return w;
   }
-  // Series s's value and derivative at the point of w.
-  void series_at(const Weights& w, int s, double& value, double& slope) const {
+  // Series s's value and first two derivatives at the point of w.
+  void series_at(const Weights& w, int s, double& value, double& slope, double& curvature) const {
     const double y0 = y_[w.i * kSeries + s], y1 = y_[(w.i + 1) * kSeries + s];
     const double c0 = y2_[w.i * kSeries + s], c1 = y2_[(w.i + 1) * kSeries + s];
     const double a = w.a, b = w.b, h = w.h;
     value = a * y0 + b * y1 + ((a * a * a - a) * c0 + (b * b * b - b) * c1) * h * h / 6.0;
     slope = (y1 - y0) / h + (-(3 * a * a - 1) * c0 + (3 * b * b - 1) * c1) * h / 6.0;
+    curvature = a * c0 + b * c1;
   }
 
   std::vector<double> x_;        // knots
@@ -375,13 +394,21 @@ struct SpherePair {
 struct SpherePairSlope {
   int a = -1, b = -1;                // cells (the carry-over's key: stable from build to build)
   double d = 0.0;
-  double dk[6] = {};                 // dK/dd, 1/m^4
-  double d0 = 0.0;                   // where k0, dk and contact were evaluated
-  double k0[6] = {};                 // K at d0 (a carried pair's K is k0 + dk (d - d0))
+  double dk[6] = {};  // dK/dd at d, 1/m^4
+  // The last evaluation, at d0 (SphereNearField::build carries from it).
+  bool evaluated = false;
+  double d0 = 0.0;
+  double k0[6] = {}, dk0[6] = {}, d2k0[6] = {};  // K, dK/dd, d2K/dd2 at d0
+  double contact0[4] = {}, dcontact0[4] = {};    // PairTable::contact at d0
   // Not evaluated at this build (two spheres whose forces are kept,
   // NearFieldTerm::set_held_cells): k is zero, and the entry is kept for a
   // later build's carry-over only.
   bool stale = false;
+};
+
+// A close pair found by the scan: the two SphereCells (cells_ indices).
+struct ClosePair {
+  int sa, sb;
 };
 
 // Each sphere's dipole p = V M and room below saturation max(0, Ms - |M|) at
@@ -417,91 +444,72 @@ class SphereNearField final : public NearFieldTerm {
       s.type = types.emplace(std::make_pair(s.radius, s.chi), static_cast<int>(types.size())).first->second;
       cells_.push_back(s);
     }
-    // The last build's pairs, in the same (a, b) order, for the carry-over
-    // (the two buffers swap: no allocation in the steady state).
-    previous_.swap(pairs_);
-    previous_slopes_.swap(slopes_);
-    if (model.generation() != generation_) {
-      previous_.clear();
-      previous_slopes_.clear();
+    if (model.generation() != generation_) {  // another model: nothing to carry over
+      pairs_.clear();
+      slopes_.clear();
     }
-    pairs_.clear();
-    slopes_.clear();
     generation_ = model.generation();
-    size_t next_previous = 0;
+    const int n = static_cast<int>(cells_.size());
+    centre_.resize(n);
+    for (int i = 0; i < n; ++i) centre_[i] = state.cell_position[cells_[i].cell];
+    if (!pair_list_holds()) {
+      make_pair_list();
+      align_last_build();
+    }
     std::map<std::pair<int, int>, std::shared_ptr<const PairTable>> tables;  // by (type a, type b)
     std::pair<int, int> last_types{-1, -1};
     const PairTable* table = nullptr;
-    // Every pair of spheres (a heap is compact: buckets of the cutoff's width
-    // would hold most of it, so they would prune little).
-    const int n = static_cast<int>(cells_.size());
-    // Centres and radii side by side: the distance test below runs over all n^2 / 2 pairs.
-    centre_.resize(n);
-    radius_.resize(n);
-    for (int i = 0; i < n; ++i) centre_[i] = state.cell_position[cells_[i].cell], radius_[i] = cells_[i].radius;
-    for (int i = 0; i < n; ++i) {
-      const Vec3 xa = centre_[i];
-      const double ra = radius_[i];
-      for (int j = i + 1; j < n; ++j) {
-        const Vec3 r = centre_[j] - xa;
-        const double d2 = dot(r, r), reach = ra + radius_[j];
-        if (d2 >= kCutoff * kCutoff * reach * reach) continue;
-        const SphereCell &ca = cells_[i], &cb = cells_[j];
-        if (!ca.multipoles() && !cb.multipoles()) continue;
-        // Without mutual induction only fixed magnets induce (one partner fixed).
-        if (!mutual_induction_ && ca.responsive && cb.responsive) continue;
-        const double d = std::sqrt(d2);
-        // Coincident centres: any axis (the functions are constant there).
-        const Vec3 u = d > 0.0 ? r / d : Vec3{0.0, 0.0, 1.0};
-        // Carried over: the pair's last evaluation, if close enough (header comment).
-        const std::pair<int, int> key{ca.cell, cb.cell};
-        while (next_previous < previous_slopes_.size() &&
-               std::make_pair(previous_slopes_[next_previous].a, previous_slopes_[next_previous].b) < key)
-          ++next_previous;
-        if (next_previous < previous_slopes_.size() &&
-            std::make_pair(previous_slopes_[next_previous].a, previous_slopes_[next_previous].b) == key) {
-          const SpherePairSlope& q = previous_slopes_[next_previous];
-          const double delta = d - q.d0;
-          if (q.d0 > reach && std::fabs(delta) <= kReuseTolerance * std::min(q.d0 - reach, reach)) {
-            SpherePair& p = pairs_.emplace_back(previous_[next_previous]);
-            SpherePairSlope& ps = slopes_.emplace_back(q);
-            p.sa = i, p.sb = j;
-            ps.d = d;
-            ps.stale = false;
-            p.u = u;
-            for (int s = 0; s < 6; ++s) p.k[s] = ps.k0[s] + ps.dk[s] * delta;
-            continue;
-          }
-        }
-        // Two spheres whose forces are kept: nothing reads this pair before
-        // the next build, so it is not evaluated (its last evaluation kept).
-        if (both_keep_force(ca.cell, cb.cell)) {
-          if (next_previous < previous_slopes_.size() &&
-              std::make_pair(previous_slopes_[next_previous].a, previous_slopes_[next_previous].b) == key) {
-            SpherePair& p = pairs_.emplace_back(previous_[next_previous]);
-            SpherePairSlope& ps = slopes_.emplace_back(previous_slopes_[next_previous]);
-            p.sa = i, p.sb = j;
-            std::fill(p.k, p.k + 6, 0.0);
-            ps.stale = true;
-          }
-          continue;
-        }
-        if (ca.type != last_types.first || cb.type != last_types.second) {  // most pairs repeat the last type
-          last_types = {ca.type, cb.type};
-          auto& t = tables[last_types];
-          if (!t) t = pair_table({ca.radius / reach, ca.chi, cb.chi});
-          table = t.get();
-        }
-        SpherePair& p = pairs_.emplace_back();
-        SpherePairSlope& ps = slopes_.emplace_back();
-        ps.a = ca.cell, ps.b = cb.cell;
-        p.sa = i, p.sb = j;
-        ps.d = ps.d0 = d;
-        p.u = u;
-        table->eval(d, reach, p.k, ps.dk);
-        table->contact(d, reach, p.contact);
-        std::copy(p.k, p.k + 6, ps.k0);
+    for (std::size_t q = 0; q < close_.size(); ++q) {
+      const SphereCell &ca = cells_[close_[q].sa], &cb = cells_[close_[q].sb];
+      SpherePair& p = pairs_[q];
+      SpherePairSlope& ps = slopes_[q];
+      p.sa = close_[q].sa, p.sb = close_[q].sb;
+      ps.a = ca.cell, ps.b = cb.cell;
+      const Vec3 r = centre_[p.sb] - centre_[p.sa];
+      const double d2 = dot(r, r), reach = ca.radius + cb.radius;
+      ps.stale = false;
+      if (d2 >= kCutoff * kCutoff * reach * reach) {  // in the list's margin: no correction
+        std::fill(p.k, p.k + 6, 0.0);
+        std::fill(ps.dk, ps.dk + 6, 0.0);
+        ps.evaluated = false;
+        continue;
       }
+      const double d = std::sqrt(d2);
+      // Coincident centres: any axis (the functions are constant there).
+      p.u = d > 0.0 ? r / d : Vec3{0.0, 0.0, 1.0};
+      ps.d = d;
+      // Carried over from the last evaluation, if close enough (header comment).
+      const double delta = d - ps.d0;
+      if (ps.evaluated && ps.d0 > reach &&
+          std::fabs(delta) <= kReuseTolerance * std::min(ps.d0 - reach, reach)) {
+        for (int s = 0; s < 6; ++s) {
+          p.k[s] = ps.k0[s] + delta * (ps.dk0[s] + 0.5 * delta * ps.d2k0[s]);
+          ps.dk[s] = ps.dk0[s] + delta * ps.d2k0[s];
+        }
+        for (int s = 0; s < 4; ++s) p.contact[s] = ps.contact0[s] + delta * ps.dcontact0[s];
+        continue;
+      }
+      // Two spheres whose forces are kept: nothing reads this pair before
+      // the next build, so it is not evaluated (its last evaluation kept).
+      if (both_keep_force(ca.cell, cb.cell)) {
+        std::fill(p.k, p.k + 6, 0.0);
+        ps.stale = true;
+        continue;
+      }
+      if (ca.type != last_types.first ||
+          cb.type != last_types.second) {  // most pairs repeat the last type
+        last_types = {ca.type, cb.type};
+        auto& t = tables[last_types];
+        if (!t) t = pair_table({ca.radius / reach, ca.chi, cb.chi});
+        table = t.get();
+      }
+      ps.evaluated = true;
+      ps.d0 = d;
+      table->eval(d, reach, ps.k0, ps.dk0, ps.d2k0);
+      table->contact(d, reach, ps.contact0, ps.dcontact0);
+      std::copy(ps.k0, ps.k0 + 6, p.k);
+      std::copy(ps.dk0, ps.dk0 + 6, ps.dk);
+      std::copy(ps.contact0, ps.contact0 + 4, p.contact);
     }
   }
 
@@ -562,6 +570,74 @@ class SphereNearField final : public NearFieldTerm {
   int pair_count() const override { return static_cast<int>(pairs_.size()); }
 
  private:
+  // Whether the pair list still holds every pair within the cutoff: the same
+  // spheres, and none has moved more than kListMargin R_min from where it
+  // was at the list's making (a pair's distance then changed by at most
+  // kListMargin (R_a + R_b)). The list then stays, its pairs updated in place.
+  bool pair_list_holds() const {
+    if (list_generation_ != generation_ || list_mutual_induction_ != mutual_induction_ ||
+        list_cells_.size() != cells_.size())
+      return false;
+    double smallest_radius = std::numeric_limits<double>::infinity(), largest_move2 = 0.0;
+    for (std::size_t i = 0; i < cells_.size(); ++i) {
+      const SphereCell &c = cells_[i], &l = list_cells_[i];
+      if (c.cell != l.cell || c.radius != l.radius || c.chi != l.chi ||
+          c.responsive != l.responsive)
+        return false;
+      smallest_radius = std::min(smallest_radius, c.radius);
+      const Vec3 move = centre_[i] - list_centre_[i];
+      largest_move2 = std::max(largest_move2, dot(move, move));
+    }
+    return largest_move2 <= kListMargin * kListMargin * smallest_radius * smallest_radius;
+  }
+  // close_: every pair within (kCutoff + kListMargin) (R_a + R_b) that can
+  // carry a correction, in (a, b) order; every pair of spheres tested (a
+  // heap is compact: buckets of the cutoff's width would hold most of it,
+  // so they would prune little; and the list is made only every few steps).
+  void make_pair_list() {
+    list_generation_ = generation_;
+    list_mutual_induction_ = mutual_induction_;
+    list_cells_ = cells_;
+    list_centre_ = centre_;
+    const int n = static_cast<int>(cells_.size());
+    const double range = kCutoff + kListMargin;
+    close_.clear();
+    for (int i = 0; i < n; ++i) {
+      const Vec3 xa = centre_[i];
+      const SphereCell& ca = cells_[i];
+      for (int j = i + 1; j < n; ++j) {
+        const Vec3 r = centre_[j] - xa;
+        const SphereCell& cb = cells_[j];
+        const double reach = ca.radius + cb.radius;
+        if (dot(r, r) >= range * range * reach * reach) continue;
+        if (!ca.multipoles() && !cb.multipoles()) continue;
+        // Without mutual induction only fixed magnets induce (one partner fixed).
+        if (!mutual_induction_ && ca.responsive && cb.responsive) continue;
+        close_.push_back({i, j});
+      }
+    }
+  }
+  // pairs_ and slopes_ resized to close_, each entry the last build's entry
+  // of the same two cells (keys in the same order: one merge pass), or new.
+  void align_last_build() {
+    previous_.swap(pairs_);
+    previous_slopes_.swap(slopes_);
+    pairs_.assign(close_.size(), SpherePair{});
+    slopes_.assign(close_.size(), SpherePairSlope{});
+    std::size_t next = 0;
+    for (std::size_t q = 0; q < close_.size(); ++q) {
+      const std::pair<int, int> key{cells_[close_[q].sa].cell, cells_[close_[q].sb].cell};
+      while (next < previous_slopes_.size() &&
+             std::make_pair(previous_slopes_[next].a, previous_slopes_[next].b) < key)
+        ++next;
+      if (next < previous_slopes_.size() &&
+          std::make_pair(previous_slopes_[next].a, previous_slopes_[next].b) == key) {
+        pairs_[q] = previous_[next];
+        slopes_[q] = previous_slopes_[next];
+      }
+    }
+  }
+
   const SphereMoments& moments(const MagneticState& state) const {
     const size_t n = cells_.size();
     moments_.dipole.resize(n);
@@ -610,10 +686,15 @@ class SphereNearField final : public NearFieldTerm {
   std::vector<SphereCell> cells_;
   std::vector<SpherePair> pairs_;
   std::vector<SpherePairSlope> slopes_;  // beside pairs_, index for index
-  std::vector<SpherePair> previous_;     // the build before, for the carry-over
+  // The pair list (make_pair_list) and what it was made from.
+  std::vector<ClosePair> close_;
+  std::vector<SphereCell> list_cells_;
+  std::vector<Vec3> list_centre_;
+  uint64_t list_generation_ = 0;
+  bool list_mutual_induction_ = true;
+  std::vector<SpherePair> previous_;  // scratch of align_last_build: the build before
   std::vector<SpherePairSlope> previous_slopes_;
-  std::vector<Vec3> centre_;           // scratch of build: the spheres' centres
-  std::vector<double> radius_;         // and radii
+  std::vector<Vec3> centre_;          // scratch of build: the spheres' centres
   uint64_t generation_ = 0;           // the model whose pairs pairs_ holds
   mutable SphereMoments moments_;  // scratch of the sums (the backends call them from one thread)
 };

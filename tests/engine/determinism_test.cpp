@@ -80,6 +80,14 @@
 // tolerance, reached from other first iterates in fewer iterations, so every
 // scene's iterates and rounding moved (all four). Outcomes in docs/scenes.md
 // "stop 32".
+// Re-pinned (stop 46) for cheaper near-field builds (issue 14): sphere pairs
+// carried to second order within 1e-2 of their gap (fields off by ~6e-9,
+// forces by ~6e-6 of a close pair's force) from a pair list kept while no
+// sphere moved 0.2 R (magnetics/sphere_near_field.cpp), and ball-lattice
+// pairs carried within 1e-3 R instead of 1e-4 R (fields ~1e-8, forces
+// ~1.2e-4 of the correction; magnetics/ball_lattice_near_field.cpp). Every
+// scene has such pairs and moved (all four). Outcomes in docs/scenes.md
+// "stop 46".
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -140,10 +148,10 @@ struct Case {
 };
 
 const Case kCases[] = {
-    {"ball_chain", 1.5, 0xf94d936026dd635fULL},
-    {"iron_plate", 1.7, 0x44c3dd2721c38b13ULL},
-    {"thin_iron_plate", 1.0, 0xbbcbd257f33ce9dcULL},
-    {"nail_and_balls", 3.2, 0xd0b4a66f5897858eULL},
+    {"ball_chain", 1.5, 0x954edad1c647f791ULL},
+    {"iron_plate", 1.7, 0xf3f102cf5bccbd73ULL},
+    {"thin_iron_plate", 1.0, 0xdaf45bd5bf6eb16dULL},
+    {"nail_and_balls", 3.2, 0xc6b38c406dd2fbdeULL},
 };
 
 // Set by tests/engine/CMakeLists.txt for a Release build with

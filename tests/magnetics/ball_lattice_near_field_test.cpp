@@ -404,19 +404,19 @@ TEST(BallLatticeNearField, ClosedSystemHasZeroNetForceAndTorque) {
   EXPECT_LT(norm(T), 1e-10 * scale * kH);
 }
 
-// A ball that moves less than the reuse tolerance (1e-4 R in the lattice
+// A ball that moves less than the reuse tolerance (1e-3 R in the lattice
 // body's frame) keeps the pairs evaluated where it was, carried to its new
 // offset to first order (T_c and the window; their gradients as they were):
 // against a fresh evaluation there, the field at the ball (the torque) agrees
 // to second order in the move, the force to first (the gradients, of
-// relative size move / distance to the cube ~ 1e-4). Measured: torque
-// 1.0e-10, force 1.2e-5 of the force (ten times less at a tenth of the
+// relative size move / distance to the cube ~ 1e-3). Measured: torque
+// 1.0e-8, force 1.2e-4 of the force (ten times less at a tenth of the
 // move, the torque a hundred times). A move past the tolerance is evaluated afresh
 // (bit for bit a new backend's), and so is a move back.
 TEST(BallLatticeNearField, PairsCarriedOverWithinTheToleranceMatchAFreshEvaluation) {
   const Vec3 Mb = 1e5 * normalized(Vec3{0.3, 0.5, -0.8});
   const Vec3 x0{0.01, 0.01, 0.02 + 1.1 * kR};  // above a lattice vertex, 0.1 R gap
-  const Vec3 move = 0.9e-4 * kR * normalized(Vec3{1.0, -2.0, 0.5});
+  const Vec3 move = 0.9e-3 * kR * normalized(Vec3{1.0, -2.0, 0.5});
   auto fresh = [&](const Vec3& x, Vec3& F, Vec3& T) {
     BallAndMagnet q = ball_and_magnet(x, Mb);
     magnetic_forces_at_held_magnetization(q.model, q.state, tight(), *q.backend);
@@ -437,8 +437,8 @@ TEST(BallLatticeNearField, PairsCarriedOverWithinTheToleranceMatchAFreshEvaluati
   std::printf("carried over %.2e R: force %.2e, torque %.2e of a fresh evaluation\n", norm(move) / kR,
               rel(F, F_ref), rel(T, T_ref));
   EXPECT_NE(F.x, F_ref.x);  // carried over, not evaluated again
-  EXPECT_LT(rel(F, F_ref), 2e-5);
-  EXPECT_LT(rel(T, T_ref), 1e-9);
+  EXPECT_LT(rel(F, F_ref), 2e-4);
+  EXPECT_LT(rel(T, T_ref), 1e-7);
   for (const Vec3& x : {x0 + 2.0 * move + 2.0 * move, x0}) {
     kept(x, F, T);
     fresh(x, F_ref, T_ref);
