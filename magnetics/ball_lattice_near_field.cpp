@@ -390,9 +390,9 @@ struct BallCellPair {
   double volume = 0.0;          // V of T_c
   double K[6];                  // world, 1/m^3
   Vec3 r;                       // x_b - x_c at build
-  PairGeometry geometry;        // at r, with the gradients (reused by add_forces)
+  double w = 0.0, Tc[6];        // the window and T_c at r (carried from base: carry_to)
   Vec3 r0;                      // x_b - x_c where `base` was evaluated
-  PairGeometry base;            // evaluated at r0 (PairGroup)
+  PairGeometry base;  // evaluated at r0 with the gradients (PairGroup), which add_forces reuses
 };
 
 // What the field sums (add_field at every outer iteration, energy) read of a
@@ -473,7 +473,7 @@ class BallLatticeNearField final : public NearFieldTerm {
           for (BallCellPair& p : group.pairs) {
             p.ball = bi;
             p.r = xb - state.cell_position[p.c];
-            carry_to(p.r - p.r0, p.base, p.geometry);
+            carry_to(p.r - p.r0, p);
             set_K(model, p);
           }
           continue;
@@ -498,21 +498,22 @@ class BallLatticeNearField final : public NearFieldTerm {
           p.half = lb.half[i];
           p.volume = lb.solid_volume[i];
           Vec3 l;
-          if (!pair_windows(p.r, R_X, lb.h, p.half, ball.radius, true, p.geometry, l)) continue;
+          if (!pair_windows(p.r, R_X, lb.h, p.half, ball.radius, true, p.base, l)) continue;
           CuboidCornerTerms t;
           if (lb.shared)
             lb.corners.terms(i, t);
           else
             cuboid_corner_terms(l, p.half, true, t);
-          pair_tensor(t, R_X, p.volume, true, p.geometry);
+          pair_tensor(t, R_X, p.volume, true, p.base);
           p.ball = bi, p.lattice = li, p.b = ball.cell, p.c = c;
           p.responsive_b = model.body(ball.body).responsive();
           p.responsive_c = model.body(lb.body).responsive();
           p.volume_b = model.cell_volume(p.b);
           p.volume_c = model.cell_volume(p.c);
           p.r0 = p.r;
-          p.base = p.geometry;
-          if (p.geometry.w_in < 1.0) group.in_fade = true;
+          p.w = p.base.w;
+          std::copy(p.base.Tc, p.base.Tc + 6, p.Tc);
+          if (p.base.w_in < 1.0) group.in_fade = true;
           set_K(model, p);
           group.pairs.push_back(p);
         }
@@ -547,28 +548,31 @@ class BallLatticeNearField final : public NearFieldTerm {
       const Vec3 r = state.cell_position[p.b] - state.cell_position[p.c];
       const Mat3& R_X = state.pose[lb.body].rotation;
       // The geometry of build where nothing has moved since (the usual case:
-      // the backends build at begin_step and take forces at the same poses).
+      // the backends build at begin_step and take forces at the same poses):
+      // w and T_c at r, the gradients of the evaluation at r0.
       PairGeometry moved;
       const bool unmoved = same(r, p.r) && same(R_X, lb.rotation);
       if (!unmoved) moved = pair_geometry(r, R_X, lb.h, p.half, p.volume, balls_[p.ball].radius, true);
-      const PairGeometry& g = unmoved ? p.geometry : moved;
-      if (g.w == 0.0) return;
+      const PairGeometry& g = unmoved ? p.base : moved;
+      const double w = unmoved ? p.w : moved.w;
+      const double* Tc = unmoved ? p.Tc : moved.Tc;
+      if (w == 0.0) return;
       const double s = model.cell_contact_radius(p.b) + model.cell_contact_radius(p.c);
       const DipoleCoefficients dc = dipole_coefficients(dot(r, r), s * s);
-      const Vec3 Tc_mu_c = symmetric_times(g.Tc, mu_c), Tc_mu_b = symmetric_times(g.Tc, mu_b);
+      const Vec3 Tc_mu_c = symmetric_times(Tc, mu_c), Tc_mu_b = symmetric_times(Tc, mu_b);
       const Vec3 T_mu_c = dipole_field(dc, r, mu_c), T_mu_b = dipole_field(dc, r, mu_b);
       const double phi0 = dot(mu_b, Tc_mu_c - T_mu_c);
       Vec3 g_c;  // grad_r (mu_b . T_c mu_c)
       for (int k = 0; k < 3; ++k) g_c[k] = dot(mu_b, symmetric_times(g.dTc[k], mu_c));
       // F_b = mu0 grad_r (w phi0); dipole_force is mu0 grad_r (mu_b . T mu_c).
-      const Vec3 F_b = kMu0 * (phi0 * g.grad_w + g.w * g_c) - g.w * dipole_force(dc, r, mu_c, mu_b);
+      const Vec3 F_b = kMu0 * (phi0 * g.grad_w + w * g_c) - w * dipole_force(dc, r, mu_c, mu_b);
       force[p.b] += F_b;
       force[p.c] -= F_b;
-      field[p.b] += g.w * (Tc_mu_c - T_mu_c);
-      field[p.c] += g.w * (Tc_mu_b - T_mu_b);
+      field[p.b] += w * (Tc_mu_c - T_mu_c);
+      field[p.c] += w * (Tc_mu_b - T_mu_b);
       // The lattice frame's pure torque (header comment).
-      torque[p.lattice] -= kMu0 * (cross(r, (phi0 * g.w_out) * g.grad_w_in + g.w * g_c) +
-                                   g.w * (cross(mu_b, Tc_mu_c) + cross(mu_c, Tc_mu_b)));
+      torque[p.lattice] -= kMu0 * (cross(r, (phi0 * g.w_out) * g.grad_w_in + w * g_c) +
+                                   w * (cross(mu_b, Tc_mu_c) + cross(mu_c, Tc_mu_b)));
     });
     for (int li : lattices_) {
       const Vec3& tau = torque[li];
@@ -603,21 +607,21 @@ class BallLatticeNearField final : public NearFieldTerm {
       for (const BallCellPair& p : groups_[gi].pairs) f(p);
   }
 
-  // K = w (T_c - T(r; s)) at the pair's geometry and r.
+  // K = w (T_c - T(r; s)) at the pair's r.
   static void set_K(const MagneticModel& model, BallCellPair& p) {
     const double s = model.cell_contact_radius(p.b) + model.cell_contact_radius(p.c);
     double dipole[6];
     dipole_tensor(p.r, s * s, dipole);
-    for (int m = 0; m < 6; ++m) p.K[m] = p.geometry.w * (p.geometry.Tc[m] - dipole[m]);
+    for (int m = 0; m < 6; ++m) p.K[m] = p.w * (p.Tc[m] - dipole[m]);
   }
 
-  // The geometry at r0 + dr from the one at r0: w and T_c to first order in
-  // dr, their gradients (and w_out, w_in) as at r0.
-  static void carry_to(const Vec3& dr, const PairGeometry& base, PairGeometry& g) {
-    g = base;
-    g.w = base.w + dot(base.grad_w, dr);
+  // w and T_c at r0 + dr from the evaluation at r0, to first order in dr
+  // (its gradients stay those at r0).
+  static void carry_to(const Vec3& dr, BallCellPair& p) {
+    const PairGeometry& base = p.base;
+    p.w = base.w + dot(base.grad_w, dr);
     for (int m = 0; m < 6; ++m)
-      g.Tc[m] = base.Tc[m] + base.dTc[0][m] * dr.x + base.dTc[1][m] * dr.y + base.dTc[2][m] * dr.z;
+      p.Tc[m] = base.Tc[m] + base.dTc[0][m] * dr.x + base.dTc[1][m] * dr.y + base.dTc[2][m] * dr.z;
   }
 
   // The model-only data of every lattice body with at least three cells spread

@@ -61,9 +61,14 @@
 // beyond, so the fields are off by O(kReuseTolerance^3) and the forces by
 // O(kReuseTolerance^2) of the correction (docs/model.md "Carried-over
 // pairs"); overlapping pairs are evaluated every time. Balls resting in a
-// heap, hanging together, or pushed about by a moving body change their
-// distances by less than that between substeps. When the close pairs are
-// those of the last build (the usual case) they are updated in place.
+// heap, hanging together, or pushed about by a moving body mostly change
+// their distances by less than that between substeps.
+//
+// The pair list: the pairs within (kCutoff + kListMargin) (R_a + R_b) are
+// found by testing every pair of spheres, and kept until a sphere has moved
+// kListMargin R_min from where it was then (no pair outside the list can
+// have come within the cutoff before); meanwhile each build updates the
+// listed pairs in place, those in the margin with no correction.
 //
 // Pairs, not clusters: the higher orders of a sphere excited by two
 // neighbours are the sum of the two pairs' (linear), but the cross terms
@@ -538,7 +543,8 @@ class SphereNearField final : public NearFieldTerm {
     for (size_t q = 0; q < pairs_.size(); ++q) {
       const SpherePair& p = pairs_[q];
       const SpherePairSlope& ps = slopes_[q];
-      if (ps.stale) continue;
+      if (ps.stale || !ps.evaluated)
+        continue;  // held forces, or in the list's margin (no correction)
       const double sigma = saturation_factor(m, p);
       const Vec3 &pa = m.dipole[p.sa], &pb = m.dipole[p.sb];
       // F_b = +mu0/2 sigma grad_r (sum_xy p_x . K_xy p_y), F_a = -F_b.
