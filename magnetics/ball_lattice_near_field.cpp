@@ -79,8 +79,8 @@
 // Carried-over pairs: a ball's pairs with a lattice body (PairGroup) are kept
 // from build to build. While the ball's centre stays within kReuseTolerance R
 // of the point q0 where they were evaluated (in the body's frame, the frame
-// not turned, and none of the pairs in the inner fade w_in < 1: overlapping
-// bodies are evaluated every time), each pair is carried to its new offset r = r0 + dr to first
+// not turned; kReuseToleranceInFade R where a pair is in the inner fade
+// w_in < 1, an overlapping ball), each pair is carried to its new offset r = r0 + dr to first
 // order, w = w0 + grad w . dr and T_c = T_c0 + (dT_c/dr) dr, with the point
 // dipole's T(r; s) exact, and the gradients as at r0. Since T_c varies on the
 // scale of delta >= kFadeEnd R, the fields (and the energy) are off by
@@ -120,6 +120,9 @@ constexpr double kMinCoupleInertia = 0.1;
 // A ball's pairs are carried over from the last evaluation while its centre
 // stays within this many R of where they were evaluated (lattice body frame).
 constexpr double kReuseTolerance = 1e-3;
+// The same where a pair is in the inner fade (an overlapping ball), where w_in
+// and T_c vary on the scale of 0.25 R: the carry's force error O(dr / 0.25 R).
+constexpr double kReuseToleranceInFade = 1e-4;
 
 // C2 step S(t) = t^3 (10 - 15 t + 6 t^2) on [0, 1], clamped; slope dS/dt.
 double quintic_step(double t, double& slope) {
@@ -407,13 +410,13 @@ struct PairCoupling {
 };
 
 // A ball's pairs with one lattice body, kept from build to build: while the
-// ball's centre stays within kReuseTolerance R of q0 in the body's frame, the
-// frame has not turned and no pair is in the inner fade, the pairs are those
-// evaluated at q0, carried to the new offset to first order (header comment).
+// ball's centre stays within kReuseTolerance R (kReuseToleranceInFade R with
+// a pair in the inner fade) of q0 in the body's frame and the frame has not
+// turned, the pairs are those evaluated at q0, carried to the new offset to
+// first order (header comment).
 struct PairGroup {
   bool valid = false;
-  // A pair in the inner fade (an overlapping ball, where w_in and T_c vary
-  // on the scale of 0.25 R): evaluated afresh at every build.
+  // A pair in the inner fade (an overlapping ball): kReuseToleranceInFade.
   bool in_fade = false;
   Vec3 q0;  // ball centre in the lattice body's frame at the evaluation
   Mat3 R0;  // the lattice body's rotation then
@@ -468,8 +471,8 @@ class BallLatticeNearField final : public NearFieldTerm {
         const std::size_t gi = static_cast<std::size_t>(ball.body) * cached_.size() + li;
         PairGroup& group = groups_[gi];
         active_groups_.push_back(gi);
-        if (group.valid && !group.in_fade && same(R_X, group.R0) &&
-            norm(q - group.q0) <= kReuseTolerance * ball.radius) {
+        const double tolerance = group.in_fade ? kReuseToleranceInFade : kReuseTolerance;
+        if (group.valid && same(R_X, group.R0) && norm(q - group.q0) <= tolerance * ball.radius) {
           for (BallCellPair& p : group.pairs) {
             p.ball = bi;
             p.r = xb - state.cell_position[p.c];
