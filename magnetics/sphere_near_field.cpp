@@ -464,12 +464,10 @@ class SphereNearField final : public NearFieldTerm {
     std::map<std::pair<int, int>, std::shared_ptr<const PairTable>> tables;  // by (type a, type b)
     std::pair<int, int> last_types{-1, -1};
     const PairTable* table = nullptr;
-    for (std::size_t q = 0; q < close_.size(); ++q) {
-      const SphereCell &ca = cells_[close_[q].sa], &cb = cells_[close_[q].sb];
+    for (std::size_t q = 0; q < pairs_.size(); ++q) {
       SpherePair& p = pairs_[q];
       SpherePairSlope& ps = slopes_[q];
-      p.sa = close_[q].sa, p.sb = close_[q].sb;
-      ps.a = ca.cell, ps.b = cb.cell;
+      const SphereCell &ca = cells_[p.sa], &cb = cells_[p.sb];
       const Vec3 r = centre_[p.sb] - centre_[p.sa];
       const double d2 = dot(r, r), reach = ca.radius + cb.radius;
       ps.stale = false;
@@ -624,7 +622,8 @@ class SphereNearField final : public NearFieldTerm {
     }
   }
   // pairs_ and slopes_ resized to close_, each entry the last build's entry
-  // of the same two cells (keys in the same order: one merge pass), or new.
+  // of the same two cells (keys in the same order: one merge pass), or new,
+  // with the list's sphere indices and cells (they stay while the list does).
   void align_last_build() {
     previous_.swap(pairs_);
     previous_slopes_.swap(slopes_);
@@ -641,6 +640,8 @@ class SphereNearField final : public NearFieldTerm {
         pairs_[q] = previous_[next];
         slopes_[q] = previous_slopes_[next];
       }
+      pairs_[q].sa = close_[q].sa, pairs_[q].sb = close_[q].sb;
+      slopes_[q].a = key.first, slopes_[q].b = key.second;
     }
   }
 
