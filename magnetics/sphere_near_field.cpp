@@ -73,8 +73,8 @@
 // Pairs, not clusters: the higher orders of a sphere excited by two
 // neighbours are the sum of the two pairs' (linear), but the cross terms
 // between neighbours through a third sphere's higher orders are neglected.
-#include <Eigen/Dense>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -386,10 +386,12 @@ struct SphereCell {
   bool multipoles() const { return !rigid(chi); }
 };
 
-// A pair's data in two parts, side by side in two arrays: what every field
-// sum reads (add_field runs at every outer iteration over tens of thousands
-// of pairs, and reading only this part halves the bytes it streams), and what
-// the forces and the carry-over read besides.
+// A pair's data in three parts, side by side in three arrays, index for
+// index: what every field sum reads (add_field runs at every outer iteration
+// over tens of thousands of pairs, and reading only this part halves the
+// bytes it streams); what the forces read besides; and the last evaluation,
+// the only part a new pair list carries over (align_last_build copies it
+// alone; the other two are set anew by every build).
 struct SpherePair {
   int sa = -1, sb = -1;              // the SphereCells
   Vec3 u;                            // (x_b - x_a) / d
@@ -397,18 +399,16 @@ struct SpherePair {
   double contact[4] = {};            // PairTable::contact
 };
 struct SpherePairSlope {
-  int a = -1, b = -1;                // cells (the carry-over's key: stable from build to build)
   double d = 0.0;
   double dk[6] = {};  // dK/dd at d, 1/m^4
-  // The last evaluation, at d0 (SphereNearField::build carries from it).
+};
+// The last evaluation, at d0 (SphereNearField::build carries from it).
+struct SpherePairEvaluation {
+  int a = -1, b = -1;  // cells (the key: stable from build to build)
   bool evaluated = false;
   double d0 = 0.0;
   double k0[6] = {}, dk0[6] = {}, d2k0[6] = {};  // K, dK/dd, d2K/dd2 at d0
   double contact0[4] = {}, dcontact0[4] = {};    // PairTable::contact at d0
-  // Not evaluated at this build (two spheres whose forces are kept,
-  // NearFieldTerm::set_held_cells): k is zero, and the entry is kept for a
-  // later build's carry-over only.
-  bool stale = false;
 };
 
 // A close pair found by the scan: the two SphereCells (cells_ indices).
@@ -452,6 +452,7 @@ class SphereNearField final : public NearFieldTerm {
     if (model.generation() != generation_) {  // another model: nothing to carry over
       pairs_.clear();
       slopes_.clear();
+      evaluations_.clear();
     }
     generation_ = model.generation();
     const int n = static_cast<int>(cells_.size());
@@ -461,59 +462,7 @@ class SphereNearField final : public NearFieldTerm {
       make_pair_list();
       align_last_build();
     }
-    std::map<std::pair<int, int>, std::shared_ptr<const PairTable>> tables;  // by (type a, type b)
-    std::pair<int, int> last_types{-1, -1};
-    const PairTable* table = nullptr;
-    for (std::size_t q = 0; q < pairs_.size(); ++q) {
-      SpherePair& p = pairs_[q];
-      SpherePairSlope& ps = slopes_[q];
-      const SphereCell &ca = cells_[p.sa], &cb = cells_[p.sb];
-      const Vec3 r = centre_[p.sb] - centre_[p.sa];
-      const double d2 = dot(r, r), reach = ca.radius + cb.radius;
-      ps.stale = false;
-      if (d2 >= kCutoff * kCutoff * reach * reach) {  // in the list's margin: no correction
-        std::fill(p.k, p.k + 6, 0.0);
-        std::fill(ps.dk, ps.dk + 6, 0.0);
-        ps.evaluated = false;
-        continue;
-      }
-      const double d = std::sqrt(d2);
-      // Coincident centres: any axis (the functions are constant there).
-      p.u = d > 0.0 ? r / d : Vec3{0.0, 0.0, 1.0};
-      ps.d = d;
-      // Carried over from the last evaluation, if close enough (header comment).
-      const double delta = d - ps.d0;
-      if (ps.evaluated && ps.d0 > reach &&
-          std::fabs(delta) <= kReuseTolerance * std::min(ps.d0 - reach, reach)) {
-        for (int s = 0; s < 6; ++s) {
-          p.k[s] = ps.k0[s] + delta * (ps.dk0[s] + 0.5 * delta * ps.d2k0[s]);
-          ps.dk[s] = ps.dk0[s] + delta * ps.d2k0[s];
-        }
-        for (int s = 0; s < 4; ++s) p.contact[s] = ps.contact0[s] + delta * ps.dcontact0[s];
-        continue;
-      }
-      // Two spheres whose forces are kept: nothing reads this pair before
-      // the next build, so it is not evaluated (its last evaluation kept).
-      if (both_keep_force(ca.cell, cb.cell)) {
-        std::fill(p.k, p.k + 6, 0.0);
-        ps.stale = true;
-        continue;
-      }
-      if (ca.type != last_types.first ||
-          cb.type != last_types.second) {  // most pairs repeat the last type
-        last_types = {ca.type, cb.type};
-        auto& t = tables[last_types];
-        if (!t) t = pair_table({ca.radius / reach, ca.chi, cb.chi});
-        table = t.get();
-      }
-      ps.evaluated = true;
-      ps.d0 = d;
-      table->eval(d, reach, ps.k0, ps.dk0, ps.d2k0);
-      table->contact(d, reach, ps.contact0, ps.dcontact0);
-      std::copy(ps.k0, ps.k0 + 6, p.k);
-      std::copy(ps.dk0, ps.dk0 + 6, ps.dk);
-      std::copy(ps.contact0, ps.contact0 + 4, p.contact);
-    }
+    update_pairs();
   }
 
   void add_field(const MagneticModel& model, const MagneticState& state, NearFieldSources sources,
@@ -521,9 +470,14 @@ class SphereNearField final : public NearFieldTerm {
     (void)model;
     const SphereMoments& m = moments(state);
     const bool responsive_sources = sources == NearFieldSources::responsive;
-    for (const SpherePair& p : pairs_) {
+    // The pairs of two held cells, whose fields nothing reads, are left out
+    // of field_pairs_ at the build; checked here only if the held cells
+    // changed since.
+    const bool held_as_built = held_as_at_build();
+    for (const int q : held_as_built ? field_pairs_ : corrected_) {
+      const SpherePair& p = pairs_[q];
       const SphereCell &ca = cells_[p.sa], &cb = cells_[p.sb];
-      if (both_held(ca.cell, cb.cell)) continue;
+      if (!held_as_built && both_held(ca.cell, cb.cell)) continue;
       const double sigma = saturation_factor(m, p);
       const Vec3 za = ca.responsive == responsive_sources ? m.dipole[p.sa] : Vec3{};
       const Vec3 zb = cb.responsive == responsive_sources ? m.dipole[p.sb] : Vec3{};
@@ -538,22 +492,21 @@ class SphereNearField final : public NearFieldTerm {
                   std::vector<Vec3>& field) const override {
     (void)model;
     const SphereMoments& m = moments(state);
-    for (size_t q = 0; q < pairs_.size(); ++q) {
+    for (const int q : corrected_) {
       const SpherePair& p = pairs_[q];
       const SpherePairSlope& ps = slopes_[q];
-      if (ps.stale || !ps.evaluated)
-        continue;  // held forces, or in the list's margin (no correction)
+      const int a = cells_[p.sa].cell, b = cells_[p.sb].cell;
       const double sigma = saturation_factor(m, p);
       const Vec3 &pa = m.dipole[p.sa], &pb = m.dipole[p.sb];
       // F_b = +mu0/2 sigma grad_r (sum_xy p_x . K_xy p_y), F_a = -F_b.
       const Vec3 g = gradient(p, ps, 0, pa, pa) + 2.0 * gradient(p, ps, 1, pa, pb) + gradient(p, ps, 2, pb, pb);
       const Vec3 Fb = 0.5 * kMu0 * sigma * g;
-      force[ps.b] += Fb;
-      force[ps.a] -= Fb;
+      force[b] += Fb;
+      force[a] -= Fb;
       Vec3 Ha, Hb;
       apply(p, pa, pb, Ha, Hb);
-      field[ps.a] += sigma * Ha;
-      field[ps.b] += sigma * Hb;
+      field[a] += sigma * Ha;
+      field[b] += sigma * Hb;
     }
   }
 
@@ -561,7 +514,8 @@ class SphereNearField final : public NearFieldTerm {
     (void)model;
     const SphereMoments& m = moments(state);
     double e = 0.0;
-    for (const SpherePair& p : pairs_) {
+    for (const int q : corrected_) {
+      const SpherePair& p = pairs_[q];
       const double sigma = saturation_factor(m, p);
       const Vec3 &pa = m.dipole[p.sa], &pb = m.dipole[p.sb];
       Vec3 Ha, Hb;
@@ -574,6 +528,74 @@ class SphereNearField final : public NearFieldTerm {
   int pair_count() const override { return static_cast<int>(pairs_.size()); }
 
  private:
+  // Every listed pair at the current centres: carried over from its last
+  // evaluation, or evaluated afresh (header comment); corrected_ and
+  // field_pairs_ made.
+  void update_pairs() {
+    if (held_cells_)
+      held_at_build_.assign(held_cells_->begin(), held_cells_->end());
+    else
+      held_at_build_.clear();
+    corrected_.clear();
+    field_pairs_.clear();
+    std::map<std::pair<int, int>, std::shared_ptr<const PairTable>> tables;  // by (type a, type b)
+    std::pair<int, int> last_types{-1, -1};
+    const PairTable* table = nullptr;
+    for (std::size_t q = 0; q < pairs_.size(); ++q) {
+      SpherePair& p = pairs_[q];
+      SpherePairSlope& ps = slopes_[q];
+      SpherePairEvaluation& e = evaluations_[q];
+      const SphereCell &ca = cells_[p.sa], &cb = cells_[p.sb];
+      const Vec3 r = centre_[p.sb] - centre_[p.sa];
+      const double d2 = dot(r, r), reach = ca.radius + cb.radius;
+      if (d2 >= kCutoff * kCutoff * reach * reach) {  // in the list's margin: no correction
+        e.evaluated = false;
+        continue;
+      }
+      const double d = std::sqrt(d2);
+      // Carried over from the last evaluation, if close enough (header comment).
+      const double delta = d - e.d0;
+      const bool carried = e.evaluated && e.d0 > reach &&
+                           std::fabs(delta) <= kReuseTolerance * std::min(e.d0 - reach, reach);
+      // Two spheres whose forces are kept: nothing reads this pair before
+      // the next build, so it is not evaluated (its last evaluation kept).
+      if (!carried && both_keep_force(ca.cell, cb.cell)) continue;
+      corrected_.push_back(static_cast<int>(q));
+      if (!both_held(ca.cell, cb.cell)) field_pairs_.push_back(static_cast<int>(q));
+      // Coincident centres: any axis (the functions are constant there).
+      p.u = d > 0.0 ? r / d : Vec3{0.0, 0.0, 1.0};
+      ps.d = d;
+      if (carried) {
+        for (int s = 0; s < 6; ++s) {
+          p.k[s] = e.k0[s] + delta * (e.dk0[s] + 0.5 * delta * e.d2k0[s]);
+          ps.dk[s] = e.dk0[s] + delta * e.d2k0[s];
+        }
+        for (int s = 0; s < 4; ++s) p.contact[s] = e.contact0[s] + delta * e.dcontact0[s];
+        continue;
+      }
+      if (ca.type != last_types.first ||
+          cb.type != last_types.second) {  // most pairs repeat the last type
+        last_types = {ca.type, cb.type};
+        auto& t = tables[last_types];
+        if (!t) t = pair_table({ca.radius / reach, ca.chi, cb.chi});
+        table = t.get();
+      }
+      e.evaluated = true;
+      e.d0 = d;
+      table->eval(d, reach, e.k0, e.dk0, e.d2k0);
+      table->contact(d, reach, e.contact0, e.dcontact0);
+      std::copy(e.k0, e.k0 + 6, p.k);
+      std::copy(e.dk0, e.dk0 + 6, ps.dk);
+      std::copy(e.contact0, e.contact0 + 4, p.contact);
+    }
+  }
+
+  // Whether the held cells (NearFieldTerm::set_held_cells) are those of the build.
+  bool held_as_at_build() const {
+    if (!held_cells_ || held_cells_->empty()) return held_at_build_.empty();
+    return *held_cells_ == held_at_build_;
+  }
+
   // Whether the pair list still holds every pair within the cutoff: the same
   // spheres, and none has moved more than kListMargin R_min from where it
   // was at the list's making (a pair's distance then changed by at most
@@ -621,28 +643,40 @@ class SphereNearField final : public NearFieldTerm {
       }
     }
   }
-  // pairs_ and slopes_ resized to close_, each entry the last build's entry
-  // of the same two cells (keys in the same order: one merge pass), or new,
-  // with the list's sphere indices and cells (they stay while the list does).
+  // pairs_, slopes_ and evaluations_ sized to close_, the list's sphere
+  // indices set (they stay while the list does), each evaluation the last
+  // build's of the same two cells (keys in the same order: one merge pass),
+  // or none. Only the evaluations are copied, each entry written once (a
+  // 1000-ball heap lists about 100,000 pairs and makes its list anew every
+  // few builds); the other two parts are set by the build.
   void align_last_build() {
-    previous_.swap(pairs_);
-    previous_slopes_.swap(slopes_);
-    pairs_.assign(close_.size(), SpherePair{});
-    slopes_.assign(close_.size(), SpherePairSlope{});
+    const std::size_t n = close_.size();
+    previous_evaluations_.swap(evaluations_);
+    reserve_with_headroom(evaluations_, n);
+    reserve_with_headroom(pairs_, n);
+    reserve_with_headroom(slopes_, n);
+    evaluations_.resize(n);
+    pairs_.resize(n);
+    slopes_.resize(n);
     std::size_t next = 0;
-    for (std::size_t q = 0; q < close_.size(); ++q) {
+    for (std::size_t q = 0; q < n; ++q) {
       const std::pair<int, int> key{cells_[close_[q].sa].cell, cells_[close_[q].sb].cell};
-      while (next < previous_slopes_.size() &&
-             std::make_pair(previous_slopes_[next].a, previous_slopes_[next].b) < key)
+      while (next < previous_evaluations_.size() &&
+             std::make_pair(previous_evaluations_[next].a, previous_evaluations_[next].b) < key)
         ++next;
-      if (next < previous_slopes_.size() &&
-          std::make_pair(previous_slopes_[next].a, previous_slopes_[next].b) == key) {
-        pairs_[q] = previous_[next];
-        slopes_[q] = previous_slopes_[next];
-      }
+      if (next < previous_evaluations_.size() &&
+          std::make_pair(previous_evaluations_[next].a, previous_evaluations_[next].b) == key)
+        evaluations_[q] = previous_evaluations_[next];
+      else
+        evaluations_[q] = SpherePairEvaluation{key.first, key.second};
       pairs_[q].sa = close_[q].sa, pairs_[q].sb = close_[q].sb;
-      slopes_[q].a = key.first, slopes_[q].b = key.second;
     }
+  }
+  // A list that grows by a few pairs should not reallocate (and fault in its
+  // pages anew) at every making.
+  template <typename T>
+  static void reserve_with_headroom(std::vector<T>& v, std::size_t n) {
+    if (v.capacity() < n) v.reserve(n + n / 4);
   }
 
   const SphereMoments& moments(const MagneticState& state) const {
@@ -692,15 +726,21 @@ class SphereNearField final : public NearFieldTerm {
 
   std::vector<SphereCell> cells_;
   std::vector<SpherePair> pairs_;
-  std::vector<SpherePairSlope> slopes_;  // beside pairs_, index for index
+  std::vector<SpherePairSlope> slopes_;            // beside pairs_, index for index
+  std::vector<SpherePairEvaluation> evaluations_;  // likewise
+  // The pairs that carry a correction at this build, in list order (not in
+  // the margin, nor two spheres whose forces are kept): what the sums walk.
+  std::vector<int> corrected_;
+  // Those of them that add_field walks: not two held cells (held_at_build_).
+  std::vector<int> field_pairs_;
+  std::vector<uint8_t> held_at_build_;
   // The pair list (make_pair_list) and what it was made from.
   std::vector<ClosePair> close_;
   std::vector<SphereCell> list_cells_;
   std::vector<Vec3> list_centre_;
   uint64_t list_generation_ = 0;
   bool list_mutual_induction_ = true;
-  std::vector<SpherePair> previous_;  // scratch of align_last_build: the build before
-  std::vector<SpherePairSlope> previous_slopes_;
+  std::vector<SpherePairEvaluation> previous_evaluations_;  // scratch of align_last_build
   std::vector<Vec3> centre_;          // scratch of build: the spheres' centres
   uint64_t generation_ = 0;           // the model whose pairs pairs_ holds
   mutable SphereMoments moments_;  // scratch of the sums (the backends call them from one thread)
