@@ -73,8 +73,8 @@
 // Pairs, not clusters: the higher orders of a sphere excited by two
 // neighbours are the sum of the two pairs' (linear), but the cross terms
 // between neighbours through a third sphere's higher orders are neglected.
-
 #include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
