@@ -70,7 +70,8 @@ class NearFieldTerm {
   // keeps the body's force (RelaxOptions::held_bodies); nullptr or empty:
   // none. add_field skips the pairs of two held cells, whose fields nothing
   // reads; add_forces those of two cells held with 2, and build need not
-  // evaluate them (set before build).
+  // evaluate them. Set before build; until the next build the cells may
+  // only be cleared (an empty vector), not changed.
   void set_held_cells(const std::vector<uint8_t>* held) { held_cells_ = held; }
 
  protected:

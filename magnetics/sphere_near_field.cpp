@@ -470,14 +470,13 @@ class SphereNearField final : public NearFieldTerm {
     (void)model;
     const SphereMoments& m = moments(state);
     const bool responsive_sources = sources == NearFieldSources::responsive;
-    // The pairs of two held cells, whose fields nothing reads, are left out
-    // of field_pairs_ at the build; checked here only if the held cells
-    // changed since.
-    const bool held_as_built = held_as_at_build();
-    for (const int q : held_as_built ? field_pairs_ : corrected_) {
+    // The pairs of two held cells, whose fields nothing reads, were left out
+    // of field_pairs_ at the build; once the held cells are cleared
+    // (NearFieldTerm::set_held_cells) every corrected pair counts.
+    const bool any_held = held_cells_ && !held_cells_->empty();
+    for (const int q : any_held ? field_pairs_ : corrected_) {
       const SpherePair& p = pairs_[q];
       const SphereCell &ca = cells_[p.sa], &cb = cells_[p.sb];
-      if (!held_as_built && both_held(ca.cell, cb.cell)) continue;
       const double sigma = saturation_factor(m, p);
       const Vec3 za = ca.responsive == responsive_sources ? m.dipole[p.sa] : Vec3{};
       const Vec3 zb = cb.responsive == responsive_sources ? m.dipole[p.sb] : Vec3{};
@@ -532,10 +531,6 @@ class SphereNearField final : public NearFieldTerm {
   // evaluation, or evaluated afresh (header comment); corrected_ and
   // field_pairs_ made.
   void update_pairs() {
-    if (held_cells_)
-      held_at_build_.assign(held_cells_->begin(), held_cells_->end());
-    else
-      held_at_build_.clear();
     corrected_.clear();
     field_pairs_.clear();
     std::map<std::pair<int, int>, std::shared_ptr<const PairTable>> tables;  // by (type a, type b)
@@ -588,12 +583,6 @@ class SphereNearField final : public NearFieldTerm {
       std::copy(e.dk0, e.dk0 + 6, ps.dk);
       std::copy(e.contact0, e.contact0 + 4, p.contact);
     }
-  }
-
-  // Whether the held cells (NearFieldTerm::set_held_cells) are those of the build.
-  bool held_as_at_build() const {
-    if (!held_cells_ || held_cells_->empty()) return held_at_build_.empty();
-    return *held_cells_ == held_at_build_;
   }
 
   // Whether the pair list still holds every pair within the cutoff: the same
@@ -731,9 +720,8 @@ class SphereNearField final : public NearFieldTerm {
   // The pairs that carry a correction at this build, in list order (not in
   // the margin, nor two spheres whose forces are kept): what the sums walk.
   std::vector<int> corrected_;
-  // Those of them that add_field walks: not two held cells (held_at_build_).
+  // Those of them that add_field walks while cells are held: not two held cells.
   std::vector<int> field_pairs_;
-  std::vector<uint8_t> held_at_build_;
   // The pair list (make_pair_list) and what it was made from.
   std::vector<ClosePair> close_;
   std::vector<SphereCell> list_cells_;
