@@ -959,6 +959,8 @@ const KeyTable<ContactSettings> kContactKeys = {
      .doc = {"number", "", "`0.2`"}},
     {.name = "rolling_friction", .check = Check::non_negative, .slot = SLOT(rolling_friction),
      .doc = {"number", "m", "`1e-5`"}},
+    {.name = "spinning_friction", .check = Check::non_negative, .slot = SLOT(spinning_friction),
+     .doc = {"number", "m", "as `rolling_friction`"}},
 };
 
 const KeyTable<SleepSettings> kSleepKeys = {

@@ -85,6 +85,10 @@ struct ContactSettings {
   // m: rolling resistance torque = this * normal force (ODE rho); 1e-5 m is
   // a rolling-resistance coefficient of 0.002 for a 5 mm steel ball.
   double rolling_friction = 1e-5;
+  // m: spinning resistance torque, about the contact normal, = this * normal
+  // force (ODE rhoN); below 0 (the default): rolling_friction.
+  double spinning_friction = -1.0;
+  double spinning() const { return spinning_friction < 0.0 ? rolling_friction : spinning_friction; }
 };
 
 // Sleeping bodies (docs/simulation.md "Sleeping bodies"): a group of bodies

@@ -41,8 +41,32 @@ constexpr long kExactSolverBodies = 32;
 
 }  // namespace
 
+dSurfaceParameters contact_surface(const ContactSettings& c) {
+  dSurfaceParameters s{};
+  s.mode = dContactBounce | dContactSoftCFM | dContactSoftERP | dContactApprox1;
+  s.mu = c.friction;
+  s.bounce = c.restitution;
+  s.bounce_vel = 0.01;
+  s.soft_cfm = c.softness;
+  s.soft_erp = c.erp;
+  const double rolling = c.rolling_friction, spinning = c.spinning();
+  if (rolling == 0.0 && spinning == 0.0) return s;
+  s.mode |= dContactRolling;
+  if (rolling == spinning) {
+    s.rho = s.rho2 = s.rhoN = rolling;
+    return s;
+  }
+  s.mode |= dContactAxisDep;  // the same bit as dContactMu2: mu2 is read too
+  s.mu2 = s.mu;
+  s.rho = s.rho2 = rolling > 0.0 ? rolling : -1.0;
+  s.rhoN = spinning > 0.0 ? spinning : -1.0;
+  return s;
+}
+
 RigidWorld::RigidWorld(const SceneDescription& scene)
-    : contact_(scene.simulation.contact), sleep_(scene.simulation.sleep), gravity_(norm(scene.gravity)) {
+    : surface_(contact_surface(scene.simulation.contact)),
+      sleep_(scene.simulation.sleep),
+      gravity_(norm(scene.gravity)) {
   const long dynamic = std::count_if(scene.bodies.begin(), scene.bodies.end(),
                                      [](const BodyDescription& b) { return !b.fixed; });
   const std::string& solver = scene.simulation.contact_solver;
@@ -418,14 +442,7 @@ void RigidWorld::near_callback(void* data, dGeomID a, dGeomID b) {
   const double skins = self->skin_of(a) + self->skin_of(b);
   for (int i = 0; i < n; ++i) {
     contact[i].geom.depth = std::max(0.0, contact[i].geom.depth - skins);
-    dSurfaceParameters& s = contact[i].surface;
-    s.mode = dContactBounce | dContactSoftCFM | dContactSoftERP | dContactApprox1 | dContactRolling;
-    s.rho = s.rho2 = s.rhoN = self->contact_.rolling_friction;
-    s.mu = self->contact_.friction;
-    s.bounce = self->contact_.restitution;
-    s.bounce_vel = 0.01;
-    s.soft_cfm = self->contact_.softness;
-    s.soft_erp = self->contact_.erp;
+    contact[i].surface = self->surface_;
     self->found_.push_back({contact[i], ba, bb});
   }
 }

@@ -17,6 +17,15 @@
 
 namespace odemag {
 
+// The surface of every contact joint. ODE gives a contact with
+// dContactRolling three rows of rolling and spinning resistance whatever their
+// coefficients, and without dContactAxisDep all three take rho; a row costs
+// as much as a normal or friction row in the quick step (docs/simulation.md
+// "Contacts"). So the rows are asked for only where their coefficients are
+// nonzero: none when both are 0, per axis (dContactAxisDep, a negative
+// coefficient: no row) when rolling and spinning differ.
+dSurfaceParameters contact_surface(const ContactSettings& c);
+
 class RigidWorld {
  public:
   // Bodies are created in scene order; "fixed" bodies are kinematic (they
@@ -164,7 +173,7 @@ class RigidWorld {
   bool has_joints_ = false;
   std::vector<Body> bodies_;
   std::vector<ForceAccumulator*> accumulators_;
-  ContactSettings contact_;
+  dSurfaceParameters surface_;  // of every contact (contact_surface)
   SleepSettings sleep_;
   double gravity_ = 0.0;  // |g|, m/s^2
   // Pairs of dynamic bodies in contact in the last integrate().

@@ -136,7 +136,7 @@ TEST(SceneParser, AllSettings) {
     "simulation": {"time_step": 0.001, "duration": 1.5, "frame_rate": 60, "solver_iterations": 20,
                    "ground": false, "ground_height": -0.1,
                    "contact": {"friction": 0.3, "restitution": 0.5, "softness": 0, "erp": 0.8,
-                               "rolling_friction": 2e-5},
+                               "rolling_friction": 2e-5, "spinning_friction": 0},
                    "linear_damping": 0.01, "angular_damping": 0.02, "max_substeps": 8,
                    "stiffness_limit": 0.5},
     "camera": {"position": [1, 0, 0], "target": [0, 0, 0], "up": [0, 0, 2], "fov": 60,
@@ -174,6 +174,7 @@ TEST(SceneParser, AllSettings) {
   EXPECT_EQ(s.simulation.linear_damping, 0.01);
   EXPECT_EQ(s.simulation.angular_damping, 0.02);
   EXPECT_EQ(s.simulation.contact.rolling_friction, 2e-5);
+  EXPECT_EQ(s.simulation.contact.spinning(), 0.0);
   EXPECT_EQ(s.simulation.max_substeps, 8);
   EXPECT_EQ(s.simulation.stiffness_limit, 0.5);
   EXPECT_EQ(s.camera.position.x, 1.0);

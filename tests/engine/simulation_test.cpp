@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "engine/sim/magnetic_system.h"
+#include "engine/sim/rigid_world.h"
 #include "magnetics/backend.h"
 #include "magnetics/constants.h"
 #include "magnetics/relax.h"
@@ -555,6 +556,120 @@ TEST(Simulation, ContactZonesFollowASlidingBall) {
   for (int s = 0; s < 2; ++s) plain.step();
   EXPECT_EQ(rezoned(plain), 0);
 }
+
+// Rolling and spinning resistance (simulation.contact.rolling_friction,
+// spinning_friction; docs/simulation.md "Contacts"): a non-magnetic ball of
+// radius R on the ground, spinning about the vertical or rolling without
+// slipping. A resistance torque rho m g about the contact normal stops a spin
+// at omega' = -rho m g / I = -5 rho g / (2 R^2) (I = 2/5 m R^2); about the
+// tangent it decelerates a ball rolling on its contact radius R' (the shape's
+// R and its collision skin, 2% of R: docs/simulation.md) at
+// a = -rho g R' / (2/5 R^2 + R'^2) (m a = -f, I a / R' = f R' - rho m g).
+// Each coefficient acts on its own axis only, and a zero one leaves that
+// motion free.
+struct ResistanceCase {
+  const char* solver;
+  double rolling, spinning;  // m; spinning < 0: the default (rolling_friction)
+};
+
+class ContactResistance : public ::testing::TestWithParam<ResistanceCase> {
+ protected:
+  static constexpr double kR = 0.005, kRolling = 1.02 * kR, kG = 9.81;
+  // The ball at rest on the ground with the given velocities, stepped for t.
+  static std::pair<Vec3, Vec3> run(const ResistanceCase& c, const Vec3& velocity,
+                                   const Vec3& angular_velocity, double t) {
+    SceneDescription s;
+    s.file = "resistance";
+    s.materials["wood"] = InertMaterial{};
+    s.bodies.push_back(body("ball", Sphere{kR}, "wood", {0, 0, kR}, false, 7800.0));
+    s.bodies.back().velocity = velocity;
+    s.bodies.back().angular_velocity = angular_velocity;
+    s.simulation.time_step = 0.001;
+    s.simulation.contact_solver = c.solver;
+    s.simulation.contact.rolling_friction = c.rolling;
+    s.simulation.contact.spinning_friction = c.spinning;
+    Simulation sim(s);
+    while (sim.time() < t - 1e-9) sim.step();
+    return {sim.world().velocity(0), sim.world().angular_velocity(0)};
+  }
+};
+
+TEST_P(ContactResistance, SpinStopsAtTheClosedFormRateOfItsCoefficient) {
+  const ResistanceCase c = GetParam();
+  const double rho = c.spinning < 0.0 ? c.rolling : c.spinning;
+  const double omega0 = 20.0, t = 0.5;
+  const double omega = run(c, {}, {0, 0, omega0}, t).second.z;
+  if (rho == 0.0) {
+    EXPECT_NEAR(omega, omega0, 1e-6 * omega0) << "free spin";
+  } else {
+    const double expected = omega0 - 5.0 * rho * kG / (2.0 * kR * kR) * t;
+    EXPECT_NEAR(omega, expected, 0.02 * (omega0 - expected)) << "2% of the spin lost";
+  }
+}
+
+TEST_P(ContactResistance, RollingBallDeceleratesAtTheClosedFormRateOfItsCoefficient) {
+  const ResistanceCase c = GetParam();
+  // Along x and along y: the contact's two friction directions (ODE's
+  // friction pyramid: a ball rolling along a diagonal of them is held back by
+  // up to sqrt(2) times as much, docs/simulation.md "Contacts").
+  const double v0 = 0.2, t = 0.5;
+  const double deceleration = c.rolling * kG * kRolling / (0.4 * kR * kR + kRolling * kRolling);
+  const double expected = v0 - deceleration * t;
+  const Vec3 along_x = run(c, {v0, 0, 0}, {0, v0 / kRolling, 0}, t).first;
+  const Vec3 along_y = run(c, {0, v0, 0}, {-v0 / kRolling, 0, 0}, t).first;
+  for (const auto& [v, across] :
+       {std::pair{along_x.x, along_x.y}, std::pair{along_y.y, along_y.x}}) {
+    EXPECT_NEAR(across, 0.0, 1e-9 * v0) << "straight on";
+    if (c.rolling == 0.0) {
+      EXPECT_NEAR(v, v0, 1e-6 * v0) << "free rolling";
+    } else {
+      EXPECT_NEAR(v, expected, 0.02 * (v0 - expected)) << "2% of the speed lost";
+    }
+  }
+}
+
+// The rows each contact asks ODE for: none of rolling or spinning
+// resistance when both coefficients are 0 (ODE adds three with
+// dContactRolling whatever they are), all three with one coefficient when
+// they are equal (the engine's surface before spinning_friction, bit for
+// bit), and per axis otherwise, a zero one without its row.
+TEST(ContactSurface, AsksForTheResistanceRowsOfNonzeroCoefficientsOnly) {
+  ContactSettings c;
+  c.rolling_friction = 0.0;
+  c.spinning_friction = 0.0;
+  EXPECT_EQ(contact_surface(c).mode & dContactRolling, 0);
+
+  c.rolling_friction = 1e-5;
+  c.spinning_friction = -1.0;  // the default: rolling_friction
+  dSurfaceParameters s = contact_surface(c);
+  EXPECT_EQ(s.mode,
+            dContactBounce | dContactSoftCFM | dContactSoftERP | dContactApprox1 | dContactRolling);
+  EXPECT_EQ(s.rho, 1e-5);
+  EXPECT_EQ(s.rho2, 1e-5);
+  EXPECT_EQ(s.rhoN, 1e-5);
+
+  c.spinning_friction = 0.0;
+  s = contact_surface(c);
+  EXPECT_NE(s.mode & dContactAxisDep, 0);
+  EXPECT_EQ(s.mu2, s.mu) << "dContactAxisDep reads mu2";
+  EXPECT_EQ(s.rho, 1e-5);
+  EXPECT_EQ(s.rho2, 1e-5);
+  EXPECT_LT(s.rhoN, 0.0) << "no spinning row";
+
+  c.rolling_friction = 0.0;
+  c.spinning_friction = 2e-5;
+  s = contact_surface(c);
+  EXPECT_LT(s.rho, 0.0);
+  EXPECT_LT(s.rho2, 0.0);
+  EXPECT_EQ(s.rhoN, 2e-5);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Coefficients, ContactResistance,
+    ::testing::Values(ResistanceCase{"quick", 1e-5, -1.0}, ResistanceCase{"quick", 1e-4, 0.0},
+                      ResistanceCase{"quick", 0.0, 1e-5}, ResistanceCase{"quick", 0.0, 0.0},
+                      ResistanceCase{"quick", 1e-4, 5e-6}, ResistanceCase{"exact", 1e-5, -1.0},
+                      ResistanceCase{"exact", 1e-4, 0.0}, ResistanceCase{"exact", 0.0, 1e-5}));
 
 }  // namespace
 }  // namespace odemag
