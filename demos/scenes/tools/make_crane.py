@@ -144,8 +144,8 @@ scene = {
 }
 if not args.electromagnet:
     # No spinning resistance about the contact normals: one row fewer per contact
-    # in ODE's quick step, T_r -20 to -25% on the crane, the same balls held over
-    # seeds (docs/benchmarks.md section 4r). The electromagnet variants were not
+    # in ODE's quick step, T_r -21% on the crane over six seeds, the same balls held
+    # (docs/benchmarks.md section 4r). The electromagnet variants were not
     # measured over seeds (at one, crane_electromagnet_small took 31% more
     # substeps), so they keep the default.
     scene["simulation"]["contact"] = {"spinning_friction": 0}
