@@ -628,6 +628,13 @@ TEST_P(ContactResistance, RollingBallDeceleratesAtTheClosedFormRateOfItsCoeffici
   }
 }
 
+INSTANTIATE_TEST_SUITE_P(
+    Coefficients, ContactResistance,
+    ::testing::Values(ResistanceCase{"quick", 1e-5, -1.0}, ResistanceCase{"quick", 1e-4, 0.0},
+                      ResistanceCase{"quick", 0.0, 1e-5}, ResistanceCase{"quick", 0.0, 0.0},
+                      ResistanceCase{"quick", 1e-4, 5e-6}, ResistanceCase{"exact", 1e-5, -1.0},
+                      ResistanceCase{"exact", 1e-4, 0.0}, ResistanceCase{"exact", 0.0, 1e-5}));
+
 // The rows each contact asks ODE for: none of rolling or spinning
 // resistance when both coefficients are 0 (ODE adds three with
 // dContactRolling whatever they are), all three with one coefficient when
@@ -663,13 +670,6 @@ TEST(ContactSurface, AsksForTheResistanceRowsOfNonzeroCoefficientsOnly) {
   EXPECT_LT(s.rho2, 0.0);
   EXPECT_EQ(s.rhoN, 2e-5);
 }
-
-INSTANTIATE_TEST_SUITE_P(
-    Coefficients, ContactResistance,
-    ::testing::Values(ResistanceCase{"quick", 1e-5, -1.0}, ResistanceCase{"quick", 1e-4, 0.0},
-                      ResistanceCase{"quick", 0.0, 1e-5}, ResistanceCase{"quick", 0.0, 0.0},
-                      ResistanceCase{"quick", 1e-4, 5e-6}, ResistanceCase{"exact", 1e-5, -1.0},
-                      ResistanceCase{"exact", 1e-4, 0.0}, ResistanceCase{"exact", 0.0, 1e-5}));
 
 }  // namespace
 }  // namespace odemag
