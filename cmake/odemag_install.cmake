@@ -41,7 +41,7 @@ set(ODEMAG_PUBLIC_HEADERS
   engine/ode/magnetic_stepper.h engine/ode/substeps.h engine/ode/exact_step.h
   engine/scene/scene.h                                              # scene loading
   engine/sim/simulation.h engine/sim/rigid_world.h engine/sim/frame_writer.h
-  engine/sim/magnetic_system.h engine/sim/outcomes.h engine/sim/solve.h  # simulation
+  engine/sim/magnetic_system.h engine/sim/outcomes.h engine/sim/solve.h engine/sim/winding_solids.h  # simulation
   gpu/cuda_backend.h
   magnetics/backend.h magnetics/cells.h magnetics/constants.h magnetics/demag_tensor.h
   magnetics/bh_curve.h magnetics/body_response.h magnetics/coil.h magnetics/hd.h magnetics/llg.h magnetics/material.h magnetics/model.h magnetics/relax.h

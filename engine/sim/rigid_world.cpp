@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "engine/ode/magnetic_forces.h"
+#include "engine/sim/winding_solids.h"
 
 namespace odemag {
 
@@ -112,6 +113,23 @@ RigidWorld::RigidWorld(const SceneDescription& scene)
     dBodySetMass(b.body, &m);
     b.mass = m.mass;
     dGeomSetBody(b.geom, b.body);
+    // The windings of its coils collide like its shape (winding_solids.h),
+    // enlarged by the same skin.
+    for (const CoilSource& coil : d.coils)
+      for (const CollisionSolid& w : winding_solids(coil)) {
+        const dGeomID g =
+            w.kind == CollisionSolid::Kind::box
+                ? dCreateBox(space_, w.size.x + 2 * skin, w.size.y + 2 * skin, w.size.z + 2 * skin)
+                : dCreateCylinder(space_, w.size.x + skin, w.size.z + 2 * skin);
+        dGeomSetBody(g, b.body);
+        dGeomSetOffsetPosition(g, w.centre.x, w.centre.y, w.centre.z);
+        dMatrix3 R{};
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) R[4 * i + j] = w.axes.m[i][j];
+        dGeomSetOffsetRotation(g, R);
+        b.windings.push_back(g);
+        b.radius = std::max(b.radius, norm(w.centre) + 0.5 * norm(w.size));
+      }
     dBodySetData(b.body, reinterpret_cast<void*>(static_cast<intptr_t>(bodies_.size())));
     dBodySetPosition(b.body, d.position.x, d.position.y, d.position.z);
     const dQuaternion q = {d.orientation.w, d.orientation.x, d.orientation.y, d.orientation.z};
@@ -194,9 +212,11 @@ void RigidWorld::set_enabled(int i, bool enabled) {
   if (enabled) {
     dBodyEnable(b.body);
     dGeomEnable(b.geom);
+    for (dGeomID g : b.windings) dGeomEnable(g);
   } else {
     dBodyDisable(b.body);
     dGeomDisable(b.geom);
+    for (dGeomID g : b.windings) dGeomDisable(g);
   }
 }
 
@@ -337,11 +357,20 @@ double RigidWorld::clearance(int i) const {
   if (!bodies_[i].geom) return 0.0;
   dReal own[6], other[6];  // min x, max x, min y, max y, min z, max z
   dGeomGetAABB(bodies_[i].geom, own);
+  for (dGeomID w : bodies_[i].windings) {  // the box around all its geoms
+    dGeomGetAABB(w, other);
+    for (int k = 0; k < 3; ++k) {
+      own[2 * k] = std::min(own[2 * k], other[2 * k]);
+      own[2 * k + 1] = std::max(own[2 * k + 1], other[2 * k + 1]);
+    }
+  }
   double nearest = std::numeric_limits<double>::infinity();
   const int n = dSpaceGetNumGeoms(space_);
   for (int g = 0; g < n; ++g) {  // in order: ODE's spaces are fast at sequential access
     const dGeomID geom = dSpaceGetGeom(space_, g);
-    if (geom == bodies_[i].geom) continue;
+    if (geom == bodies_[i].geom ||
+        (!bodies_[i].windings.empty() && dGeomGetBody(geom) == bodies_[i].body))
+      continue;
     dGeomGetAABB(geom, other);
     double gap2 = 0.0;
     for (int k = 0; k < 3; ++k) {
@@ -380,6 +409,8 @@ void RigidWorld::stop_riding_where_hit() {
   for (int i : leaving) {
     recollided_ = i;
     dSpaceCollide2(bodies_[i].geom, reinterpret_cast<dGeomID>(space_), this, &RigidWorld::near_callback);
+    for (dGeomID w : bodies_[i].windings)
+      dSpaceCollide2(w, reinterpret_cast<dGeomID>(space_), this, &RigidWorld::near_callback);
   }
   recollided_ = -1;
   for (int i : leaving) bodies_[i].recollide_rank = -1;

@@ -126,6 +126,7 @@ class RigidWorld {
   struct Body {
     dBodyID body = nullptr;
     dGeomID geom = nullptr;
+    std::vector<dGeomID> windings;  // the solids of its coils' windings (winding_solids.h)
     bool kinematic = false;
     bool enabled = true;
     double mass = 0.0;

@@ -32,7 +32,7 @@ args = p.parse_args()
 rng = random.Random(args.seed)
 
 R = 0.005                  # ball radius, m
-bin_half = 0.065           # inner half width of the bin, m
+heap_half = 0.065          # half width of the balls' first layer, m
 crane = [0.12, 0.12, 0.03]  # crane magnet (box), m
 h_crane = 0.012            # its lattice spacing: 10 x 10 x 2 = 200 cells
 # --electromagnet: the winding around the core, a rounded-rectangle coil from
@@ -59,7 +59,7 @@ def random_quaternion():
 
 # Balls stacked in square layers (slightly apart), the bin holding them.
 balls = []
-per_row = int((2 * bin_half) / (2 * R * 1.02))
+per_row = int((2 * heap_half) / (2 * R * 1.02))
 layer = 0
 while len(balls) < args.balls:
     offset = R * 1.02 if layer % 2 else 0.0
@@ -68,13 +68,20 @@ while len(balls) < args.balls:
         for j in range(n):
             if len(balls) >= args.balls:
                 break
-            x = -bin_half + R * 1.02 + offset + 2 * R * 1.02 * i
-            y = -bin_half + R * 1.02 + offset + 2 * R * 1.02 * j
+            x = -heap_half + R * 1.02 + offset + 2 * R * 1.02 * i
+            y = -heap_half + R * 1.02 + offset + 2 * R * 1.02 * j
             z = R * 1.01 + layer * 2 * R * 0.75
             balls.append([x, y, z])
     layer += 1
 top = max(b[2] for b in balls) + R
 wall_h = 0.05
+bin_half = heap_half       # inner half width of the bin, m
+if args.electromagnet:
+    # The winding reaches 42 mm beyond the core's sides and comes down with
+    # the pole face below the walls' top: the bin is wide enough for it (5 mm
+    # clear), or it would pass through the walls and press the balls on them
+    # into its copper (a solid for the balls, docs/simulation.md "Coil windings").
+    bin_half = crane[0] / 2 + coil_gap + coil_build + 0.005
 crane_body = {"name": "crane", "shape": {"box": crane}, "material": "crane_core", "position": [0, 0, 0.2],
               "fixed": True, "cell_size": h_crane}
 core_material = {"type": "soft", "saturation": 1.7e6, "susceptibility": 1000,
@@ -142,12 +149,10 @@ scene = {
         {"name": "held_off", "count_above": {"prefix": "ball_", "height": 0.1}},
     ],
 }
-if not args.electromagnet:
-    # No spinning resistance about the contact normals: one row fewer per contact
-    # in ODE's quick step, T_r -21% on the crane over six seeds, the same balls held
-    # (docs/benchmarks.md section 4r). The electromagnet variants were not
-    # measured over seeds (at one, crane_electromagnet_small took 31% more
-    # substeps), so they keep the default.
-    scene["simulation"]["contact"] = {"spinning_friction": 0}
+# No spinning resistance about the contact normals: one row fewer per contact
+# in ODE's quick step, T_r -21% on the crane over six seeds, the same balls held
+# (docs/benchmarks.md section 4r); crane_electromagnet_small over three seeds:
+# T_r -15%, the same substeps and counts within their spread (docs/scenes.md).
+scene["simulation"]["contact"] = {"spinning_friction": 0}
 json.dump(scene, open(args.out, "w"), indent=1)
 print(f"{len(balls)} balls in {layer} layers, heap top {top:.4f} m, crane face at {low - crane[2] / 2:.4f} m")
