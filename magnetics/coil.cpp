@@ -14,6 +14,23 @@
 
 namespace odemag {
 
+CoilFrame frame_from_axis(const Vec3& axis) {
+  CoilFrame f;
+  f.e3 = normalized(axis);
+  const Vec3 helper = std::abs(f.e3.x) < 0.9 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
+  f.e1 = normalized(cross(helper, f.e3));
+  f.e2 = cross(f.e3, f.e1);
+  return f;
+}
+
+CoilFrame frame_from_axis_and(const Vec3& axis, const Vec3& first) {
+  CoilFrame f;
+  f.e3 = normalized(axis);
+  f.e1 = normalized(first - dot(first, f.e3) * f.e3);
+  f.e2 = cross(f.e3, f.e1);
+  return f;
+}
+
 namespace {
 
 constexpr int kMaxOrder = 64;
@@ -120,29 +137,6 @@ void graded_rects(const Rect& domain, double s0, double s1, double h0, std::vect
         add(s0 + g[i], s0 + g[i + 1], s1 + g[j], s1 + g[j + 1]);
       }
   }
-}
-
-// Orthonormal frame with e3 along axis.
-struct Frame {
-  Vec3 e1, e2, e3;
-};
-
-Frame frame_from_axis(const Vec3& axis) {
-  Frame f;
-  f.e3 = normalized(axis);
-  const Vec3 helper = std::abs(f.e3.x) < 0.9 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
-  f.e1 = normalized(cross(helper, f.e3));
-  f.e2 = cross(f.e3, f.e1);
-  return f;
-}
-
-// Frame with e3 along axis and e1 along the part of `first` normal to it.
-Frame frame_from_axis_and(const Vec3& axis, const Vec3& first) {
-  Frame f;
-  f.e3 = normalized(axis);
-  f.e1 = normalized(first - dot(first, f.e3) * f.e3);
-  f.e2 = cross(f.e3, f.e1);
-  return f;
 }
 
 // Two of Bulirsch's cel with the same kc and p > 0 (the iteration on kc and p
@@ -433,11 +427,11 @@ Vec3 corner_field(const RoundedRectangleCoil& c, const CoilCorner& corner, const
 }
 
 // Local coordinates of a point in a frame at origin.
-Vec3 to_local(const Frame& f, const Vec3& origin, const Vec3& point) {
+Vec3 to_local(const CoilFrame& f, const Vec3& origin, const Vec3& point) {
   const Vec3 d = point - origin;
   return {dot(d, f.e1), dot(d, f.e2), dot(d, f.e3)};
 }
-Vec3 to_global(const Frame& f, const Vec3& v) { return v.x * f.e1 + v.y * f.e2 + v.z * f.e3; }
+Vec3 to_global(const CoilFrame& f, const Vec3& v) { return v.x * f.e1 + v.y * f.e2 + v.z * f.e3; }
 
 bool finite(double v) { return std::isfinite(v); }
 bool finite(const Vec3& v) { return is_finite(v); }
@@ -610,7 +604,7 @@ Vec3 coil_field_H(const Arc& arc, const Vec3& point) {
   const double a = arc.radius;
   if (!(a > 0.0) || arc.angle == 0.0) return {};
   const double angle = std::abs(arc.angle);
-  const Frame f = frame_from_axis_and(arc.angle > 0.0 ? arc.axis : -arc.axis, arc.start);
+  const CoilFrame f = frame_from_axis_and(arc.angle > 0.0 ? arc.axis : -arc.axis, arc.start);
   const Vec3 local = to_local(f, arc.centre, point);
   const double rho = std::hypot(local.x, local.y), z = local.z;
   const double psi = rho > 0.0 ? std::atan2(local.y, local.x) : 0.0;
@@ -702,7 +696,7 @@ Vec3 coil_field_H(const CircularCoil& coil, const Vec3& point) {
 Vec3 coil_field_H(const RoundedRectangleCoil& coil, const Vec3& point) {
   const double width = coil.outer_corner_radius - coil.inner_corner_radius;
   if (!(width > 0.0) || !(coil.height > 0.0)) return {};
-  const Frame f = frame_from_axis_and(coil.axis, coil.width_direction);
+  const CoilFrame f = frame_from_axis_and(coil.axis, coil.width_direction);
   const Vec3 p = to_local(f, coil.centre, point);
   const double j = coil.current * coil.turns / (width * coil.height);
   const CoilParts parts = rounded_rectangle_parts(coil);
@@ -825,8 +819,8 @@ double ampere_turns(const CoilSource& source) {
 
 namespace {
 
-void add_circle(std::vector<CurrentElement>& out, const Frame& f, const Vec3& centre, double radius, double ni,
-                int per_turn) {
+void add_circle(std::vector<CurrentElement>& out, const CoilFrame& f, const Vec3& centre,
+                double radius, double ni, int per_turn) {
   const double step = 2.0 * kPi / per_turn;
   for (int k = 0; k < per_turn; ++k) {
     const double phi = step * k;
@@ -854,7 +848,7 @@ std::vector<CurrentElement> current_elements(const CoilSource& source, const Ele
           const Vec3 mid = 0.5 * (s.a + s.b), half = 0.5 * (s.b - s.a);
           for (int i = 0; i < along; ++i) out.push_back({mid + rule_along.x[i] * half, (ni * rule_along.w[i]) * half});
         } else if constexpr (std::is_same_v<T, Arc>) {
-          const Frame f = frame_from_axis_and(s.axis, s.start);
+          const CoilFrame f = frame_from_axis_and(s.axis, s.start);
           const double half = 0.5 * s.angle;
           for (int i = 0; i < along; ++i) {
             const double phi = half + half * rule_along.x[i];
@@ -863,7 +857,7 @@ std::vector<CurrentElement> current_elements(const CoilSource& source, const Ele
                            (ni * s.radius * half * rule_along.w[i]) * (c * f.e2 - sn * f.e1)});
           }
         } else if constexpr (std::is_same_v<T, Solenoid>) {
-          const Frame f = frame_from_axis(s.axis);
+          const CoilFrame f = frame_from_axis(s.axis);
           if (!(s.length > 0.0)) {
             add_circle(out, f, s.centre, s.radius, ni, per_turn);
             return;
@@ -872,7 +866,7 @@ std::vector<CurrentElement> current_elements(const CoilSource& source, const Ele
             add_circle(out, f, s.centre + (0.5 * s.length * rule_across.x[i]) * f.e3, s.radius,
                        0.5 * ni * rule_across.w[i], per_turn);
         } else if constexpr (std::is_same_v<T, CircularCoil>) {
-          const Frame f = frame_from_axis(s.axis);
+          const CoilFrame f = frame_from_axis(s.axis);
           const double r_mid = 0.5 * (s.inner_radius + s.outer_radius), r_half = 0.5 * (s.outer_radius - s.inner_radius);
           const int nr = r_half > 0.0 ? across : 1;
           const int nz = s.length > 0.0 ? across : 1;
@@ -883,7 +877,7 @@ std::vector<CurrentElement> current_elements(const CoilSource& source, const Ele
               add_circle(out, f, s.centre + (0.5 * s.length * rz.x[k]) * f.e3, r_mid + r_half * rr.x[i],
                          ni * 0.25 * rr.w[i] * rz.w[k], per_turn);
         } else if constexpr (std::is_same_v<T, RoundedRectangleCoil>) {
-          const Frame f = frame_from_axis_and(s.axis, s.width_direction);
+          const CoilFrame f = frame_from_axis_and(s.axis, s.width_direction);
           const double width = s.outer_corner_radius - s.inner_corner_radius;
           const double j = ni / (width * s.height);
           const CoilParts parts = rounded_rectangle_parts(s);

@@ -120,6 +120,15 @@ struct RoundedRectangleCoil {
 
 using CoilSource = std::variant<CircularLoop, StraightSegment, Arc, Solenoid, CircularCoil, RoundedRectangleCoil>;
 
+// The orthonormal frame of a source (e1, e2, e3 = e3 x e1): e3 along `axis`;
+// e1 along the part of `first` normal to it (a rounded rectangle's
+// width_direction: its u, v, w), or a fixed choice normal to the axis.
+struct CoilFrame {
+  Vec3 e1, e2, e3;
+};
+CoilFrame frame_from_axis(const Vec3& axis);
+CoilFrame frame_from_axis_and(const Vec3& axis, const Vec3& first);
+
 // Why a source is not a valid geometry ("" when it is): non-positive radius,
 // zero axis, inner radius above outer, quadrature order outside 1..64, ...
 std::string coil_source_error(const CoilSource& source);

@@ -51,9 +51,8 @@ std::vector<CollisionSolid> winding_solids(const CoilSource& coil) {
       [&](const auto& c) {
         using T = std::decay_t<decltype(c)>;
         if constexpr (std::is_same_v<T, CircularCoil>) {
-          const Vec3 w = normalized(c.axis);
-          const Vec3 helper = std::abs(w.x) < 0.9 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
-          const Vec3 u = normalized(cross(helper, w)), v = cross(w, u);
+          const CoilFrame f = frame_from_axis(c.axis);
+          const Vec3 &u = f.e1, &v = f.e2, &w = f.e3;
           if (c.inner_radius == 0.0) {
             out.push_back({CollisionSolid::Kind::cylinder,
                            c.centre,
@@ -64,11 +63,9 @@ std::vector<CollisionSolid> winding_solids(const CoilSource& coil) {
                              c.length, out);
           }
         } else if constexpr (std::is_same_v<T, RoundedRectangleCoil>) {
-          // The frame of magnetics/coil.h: u along width_direction normal to
-          // the axis, w along the axis, v = w x u.
-          const Vec3 w = normalized(c.axis);
-          const Vec3 u = normalized(c.width_direction - dot(c.width_direction, w) * w),
-                     v = cross(w, u);
+          // The coil's own frame (magnetics/coil.h): u along width_direction, w along the axis.
+          const CoilFrame f = frame_from_axis_and(c.axis, c.width_direction);
+          const Vec3 &u = f.e1, &v = f.e2, &w = f.e3;
           const Mat3 axes = from_columns(u, v, w);
           const double a = c.core_half_width, b = c.core_half_depth,
                        build = c.outer_corner_radius - c.inner_corner_radius;

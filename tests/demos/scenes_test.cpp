@@ -23,6 +23,7 @@
 #include "magnetics/backend.h"
 #include "magnetics/coil.h"
 #include "magnetics/constants.h"
+#include "tests/support/windings.h"
 
 namespace odemag {
 namespace {
@@ -383,11 +384,7 @@ TEST(CraneElectromagnetScene, NoBallEntersTheWinding) {
       if (sim.scene().bodies[b].name.rfind("ball_", 0) != 0) continue;
       const Vec3 x =
           c.rotation.transpose_times(sim.world().pose(b).position - c.position) - coil->centre;
-      const double d = std::hypot(std::max(std::abs(x.x) - coil->core_half_width, 0.0),
-                                  std::max(std::abs(x.y) - coil->core_half_depth, 0.0));
-      closest =
-          std::min(closest, std::max({coil->inner_corner_radius - d, d - coil->outer_corner_radius,
-                                      std::abs(x.z) - 0.5 * coil->height, 0.0}));
+      closest = std::min(closest, test_support::distance_from_copper(*coil, x.x, x.y, x.z));
     }
   }
   std::printf("closest approach of a ball's centre to the winding's copper: %.3f R\n", closest / R);

@@ -12,11 +12,14 @@
 #include "engine/sim/simulation.h"
 #include "magnetics/constants.h"
 #include "tests/support/scene_builders.h"
+#include "tests/support/windings.h"
 
 namespace odemag {
 namespace {
 
 using test_support::body;
+using test_support::core_rectangle_distance;
+using test_support::distance_from_copper;
 using test_support::weightless_scene;
 
 // How far beyond the copper the boxes of round parts may reach, relative to
@@ -103,8 +106,7 @@ TEST(WindingSolids, CoverARoundedRectangleCoilsCopperAndLeaveItsCoreFree) {
   for (int i = 0; i < 60000; ++i) {
     const double pu = 0.07 * unit(rng), pv = 0.05 * unit(rng), pw = c.height * unit(rng);
     const Vec3 p = c.centre + pu * u + pv * v + pw * w;
-    const double d = std::hypot(std::max(std::abs(pu) - c.core_half_width, 0.0),
-                                std::max(std::abs(pv) - c.core_half_depth, 0.0));
+    const double d = core_rectangle_distance(c, pu, pv);
     if (d >= c.inner_corner_radius && d <= c.outer_corner_radius &&
         std::abs(pw) <= 0.5 * c.height) {
       ++copper;
@@ -186,17 +188,13 @@ TEST(WindingSolids, BallsSentAtARoundedRectangleWindingStayOutOfTheCopper) {
                           {-0.012, 0.0, -0.004}));  // between the frame and the winding
   s.bodies.back().velocity = {0.0, speed, 0.0};
   Simulation sim(s);
-  auto distance = [&](int i) {  // from the copper's surface (0 inside)
-    const Vec3 p = sim.world().pose(i).position;
-    const double d = std::hypot(std::max(std::abs(p.x) - c.core_half_width, 0.0),
-                                std::max(std::abs(p.y) - c.core_half_depth, 0.0));
-    return std::max({c.inner_corner_radius - d, d - c.outer_corner_radius,
-                     std::abs(p.z) - 0.5 * c.height, 0.0});
-  };
   double closest[4] = {1.0, 1.0, 1.0, 1.0};
   while (sim.time() < 0.6) {
     sim.step();
-    for (int i = 1; i <= 3; ++i) closest[i] = std::min(closest[i], distance(i));
+    for (int i = 1; i <= 3; ++i) {  // the coil's frame is the world's
+      const Vec3 p = sim.world().pose(i).position;
+      closest[i] = std::min(closest[i], distance_from_copper(c, p.x, p.y, p.z));
+    }
   }
   for (int i = 1; i <= 3; ++i) {
     EXPECT_GT(closest[i], 0.95 * kR)
