@@ -961,6 +961,8 @@ const KeyTable<ContactSettings> kContactKeys = {
      .doc = {"number", "m", "`1e-5`"}},
     {.name = "spinning_friction", .check = Check::non_negative, .slot = SLOT(spinning_friction),
      .doc = {"number", "m", "as `rolling_friction`"}},
+    {.name = "rolling_axes", .check = Check::choice, .slot = SLOT(rolling_axes), .words = {"both", "rolling"},
+     .doc = {"string", "", "`\"both\"`"}},
 };
 
 const KeyTable<SleepSettings> kSleepKeys = {

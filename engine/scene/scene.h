@@ -89,6 +89,13 @@ struct ContactSettings {
   // force (ODE rhoN); below 0 (the default): rolling_friction.
   double spinning_friction = -1.0;
   double spinning() const { return spinning_friction < 0.0 ? rolling_friction : spinning_friction; }
+  // The axes of the rolling resistance (docs/simulation.md "Contacts"):
+  // "both", a row about each of the contact's two tangent directions (ODE's
+  // pyramid: sqrt 2 times the torque along their diagonal); "rolling", one
+  // row about the axis the two bodies roll about relative to each other at
+  // the substep's start (the torque rho N along any direction, one row
+  // fewer), both rows while they do not roll.
+  std::string rolling_axes = "both";
 };
 
 // Sleeping bodies (docs/simulation.md "Sleeping bodies"): a group of bodies

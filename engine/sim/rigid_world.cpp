@@ -40,6 +40,13 @@ constexpr double kSkinFraction = 0.02;
 // grows with the cube of the contacts of an island).
 constexpr long kExactSolverBodies = 32;
 
+// A body's angular velocity; zero for the ground and static geoms (nullptr).
+Vec3 angular_velocity_of(dBodyID body) {
+  if (!body) return Vec3{0.0, 0.0, 0.0};
+  const dReal* w = dBodyGetAngularVel(body);
+  return Vec3{w[0], w[1], w[2]};
+}
+
 }  // namespace
 
 dSurfaceParameters contact_surface(const ContactSettings& c) {
@@ -64,8 +71,28 @@ dSurfaceParameters contact_surface(const ContactSettings& c) {
   return s;
 }
 
+void align_rolling_row(dContact& contact, const Vec3& relative_omega) {
+  dSurfaceParameters& s = contact.surface;
+  if (!(s.mode & dContactRolling) || s.rho <= 0.0) return;
+  const Vec3 n{contact.geom.normal[0], contact.geom.normal[1], contact.geom.normal[2]};
+  const Vec3 omega_t = relative_omega - dot(relative_omega, n) * n;
+  const double rolling_rate = norm(omega_t);
+  if (!(rolling_rate > kRollingAxisMinimum)) return;
+  const Vec3 axis = omega_t / rolling_rate;
+  // Without dContactAxisDep all three rows took rho: spinning as rolling.
+  const double spinning = (s.mode & dContactAxisDep) ? s.rhoN : s.rho;
+  s.mode |= dContactAxisDep | dContactFDir1;  // dContactAxisDep reads mu2 too
+  s.mu2 = s.mu;
+  s.rho2 = -1.0;  // no row about n x axis, the direction the contact rolls along
+  s.rhoN = spinning > 0.0 ? spinning : -1.0;
+  contact.fdir1[0] = axis.x;
+  contact.fdir1[1] = axis.y;
+  contact.fdir1[2] = axis.z;
+}
+
 RigidWorld::RigidWorld(const SceneDescription& scene)
     : surface_(contact_surface(scene.simulation.contact)),
+      rolling_axis_aligned_(scene.simulation.contact.rolling_axes == "rolling"),
       sleep_(scene.simulation.sleep),
       gravity_(norm(scene.gravity)) {
   const long dynamic = std::count_if(scene.bodies.begin(), scene.bodies.end(),
@@ -497,7 +524,10 @@ void RigidWorld::create_contact_joints() {
   for (const FoundContact& f : found_) {
     const bool a_sleeps = sleeps(f.a), b_sleeps = sleeps(f.b);
     if (fixed(f.a, a_sleeps) && fixed(f.b, b_sleeps)) continue;
-    dJointID j = dJointCreateContact(world_, contacts_, &f.contact);
+    dContact contact = f.contact;
+    if (rolling_axis_aligned_)
+      align_rolling_row(contact, angular_velocity_of(f.a) - angular_velocity_of(f.b));
+    dJointID j = dJointCreateContact(world_, contacts_, &contact);
     dJointAttach(j, a_sleeps ? nullptr : f.a, b_sleeps ? nullptr : f.b);
   }
   found_.clear();

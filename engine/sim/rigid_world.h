@@ -26,6 +26,18 @@ namespace odemag {
 // coefficient: no row) when rolling and spinning differ.
 dSurfaceParameters contact_surface(const ContactSettings& c);
 
+// The rolling resistance of one contact about the axis its bodies roll about
+// (ContactSettings::rolling_axes "rolling"): omega_rel = omega_a - omega_b at
+// the substep's start; where its part in the contact plane, omega_t, is
+// above kRollingAxisMinimum, the contact's first tangent direction (fdir1,
+// the first friction and rolling axis) is omega_t / |omega_t| and it keeps
+// one rolling row, about that axis: one row fewer, and the torque rho N
+// whatever the direction of rolling. Below it (bodies at rest relative to
+// each other) the contact keeps both rows of `contact`'s surface. A surface
+// without rolling resistance is left as it is.
+constexpr double kRollingAxisMinimum = 1e-9;  // rad/s
+void align_rolling_row(dContact& contact, const Vec3& relative_omega);
+
 class RigidWorld {
  public:
   // Bodies are created in scene order; "fixed" bodies are kinematic (they
@@ -175,6 +187,7 @@ class RigidWorld {
   std::vector<Body> bodies_;
   std::vector<ForceAccumulator*> accumulators_;
   dSurfaceParameters surface_;  // of every contact (contact_surface)
+  bool rolling_axis_aligned_ = false;  // ContactSettings::rolling_axes "rolling": align_rolling_row
   SleepSettings sleep_;
   double gravity_ = 0.0;  // |g|, m/s^2
   // Pairs of dynamic bodies in contact in the last integrate().

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "engine/sim/magnetic_system.h"
 #include "engine/sim/rigid_world.h"
@@ -566,10 +567,12 @@ TEST(Simulation, ContactZonesFollowASlidingBall) {
 // R and its collision skin, 2% of R: docs/simulation.md) at
 // a = -rho g R' / (2/5 R^2 + R'^2) (m a = -f, I a / R' = f R' - rho m g).
 // Each coefficient acts on its own axis only, and a zero one leaves that
-// motion free.
+// motion free. With rolling_axes "rolling" (one row about the axis the ball
+// rolls about) the same closed forms hold along any direction of rolling.
 struct ResistanceCase {
   const char* solver;
   double rolling, spinning;  // m; spinning < 0: the default (rolling_friction)
+  const char* axes = "both";  // ContactSettings::rolling_axes
 };
 
 class ContactResistance : public ::testing::TestWithParam<ResistanceCase> {
@@ -588,6 +591,7 @@ class ContactResistance : public ::testing::TestWithParam<ResistanceCase> {
     s.simulation.contact_solver = c.solver;
     s.simulation.contact.rolling_friction = c.rolling;
     s.simulation.contact.spinning_friction = c.spinning;
+    s.simulation.contact.rolling_axes = c.axes;
     Simulation sim(s);
     while (sim.time() < t - 1e-9) sim.step();
     return {sim.world().velocity(0), sim.world().angular_velocity(0)};
@@ -628,12 +632,34 @@ TEST_P(ContactResistance, RollingBallDeceleratesAtTheClosedFormRateOfItsCoeffici
   }
 }
 
+// Along the diagonal of the contact's two friction directions (x and y for
+// a ball on the ground): with "both", ODE bounds each rolling row by rho N on
+// its own (a pyramid), so the ball is held back by sqrt(2) times the closed
+// form; with "rolling", by the closed form, as along x or y.
+TEST_P(ContactResistance, RollingAlongTheDiagonalOfTheFrictionDirections) {
+  const ResistanceCase c = GetParam();
+  if (c.rolling == 0.0) GTEST_SKIP() << "no rolling resistance";
+  const double v0 = 0.2, t = 0.5;
+  const double deceleration = c.rolling * kG * kRolling / (0.4 * kR * kR + kRolling * kRolling);
+  const double held_back = std::string(c.axes) == "rolling" ? 1.0 : std::sqrt(2.0);
+  const double u = v0 / std::sqrt(2.0);
+  const Vec3 v = run(c, {u, u, 0}, {-u / kRolling, u / kRolling, 0}, t).first;
+  const double speed_lost = v0 - std::hypot(v.x, v.y);
+  EXPECT_NEAR(speed_lost, held_back * deceleration * t, 0.02 * held_back * deceleration * t);
+  EXPECT_NEAR(v.x, v.y, 1e-9 * v0) << "straight on";
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Coefficients, ContactResistance,
     ::testing::Values(ResistanceCase{"quick", 1e-5, -1.0}, ResistanceCase{"quick", 1e-4, 0.0},
                       ResistanceCase{"quick", 0.0, 1e-5}, ResistanceCase{"quick", 0.0, 0.0},
                       ResistanceCase{"quick", 1e-4, 5e-6}, ResistanceCase{"exact", 1e-5, -1.0},
-                      ResistanceCase{"exact", 1e-4, 0.0}, ResistanceCase{"exact", 0.0, 1e-5}));
+                      ResistanceCase{"exact", 1e-4, 0.0}, ResistanceCase{"exact", 0.0, 1e-5},
+                      ResistanceCase{"quick", 1e-5, -1.0, "rolling"},
+                      ResistanceCase{"quick", 1e-4, 0.0, "rolling"},
+                      ResistanceCase{"quick", 1e-4, 5e-6, "rolling"},
+                      ResistanceCase{"exact", 1e-4, 0.0, "rolling"},
+                      ResistanceCase{"exact", 1e-5, -1.0, "rolling"}));
 
 // The rows each contact asks ODE for: none of rolling or spinning
 // resistance when both coefficients are 0 (ODE adds three with
@@ -669,6 +695,56 @@ TEST(ContactSurface, AsksForTheResistanceRowsOfNonzeroCoefficientsOnly) {
   EXPECT_LT(s.rho, 0.0);
   EXPECT_LT(s.rho2, 0.0);
   EXPECT_EQ(s.rhoN, 2e-5);
+}
+
+// align_rolling_row (rolling_axes "rolling"): a contact whose bodies roll
+// relative to each other keeps one rolling row, about their relative angular
+// velocity's part in the contact plane (fdir1), and its spinning row as the
+// surface had it; at rest, or spinning about the normal only, it keeps the
+// surface's rows; a surface without rolling resistance is left alone.
+TEST(ContactSurface, OneRollingRowAboutTheAxisTheBodiesRollAbout) {
+  ContactSettings c;
+  c.rolling_friction = 1e-5;
+  c.spinning_friction = 0.0;
+  dContact contact{};
+  contact.surface = contact_surface(c);
+  contact.geom.normal[2] = 1.0;
+  dContact aligned = contact;
+  align_rolling_row(aligned, {0.0, -3.0, 7.0});  // rolls about -y, spins about z
+  EXPECT_NE(aligned.surface.mode & dContactFDir1, 0);
+  EXPECT_NE(aligned.surface.mode & dContactAxisDep, 0);
+  EXPECT_EQ(aligned.surface.mu2, aligned.surface.mu);
+  EXPECT_EQ(aligned.fdir1[0], 0.0);
+  EXPECT_EQ(aligned.fdir1[1], -1.0);
+  EXPECT_EQ(aligned.fdir1[2], 0.0);
+  EXPECT_EQ(aligned.surface.rho, 1e-5);
+  EXPECT_LT(aligned.surface.rho2, 0.0) << "no row about n x fdir1";
+  EXPECT_LT(aligned.surface.rhoN, 0.0) << "no spinning row, as the surface";
+
+  for (const Vec3& omega : {Vec3{0.0, 0.0, 0.0}, Vec3{0.0, 0.0, 5.0}, Vec3{1e-10, 0.0, 0.0}}) {
+    dContact kept = contact;
+    align_rolling_row(kept, omega);
+    EXPECT_EQ(kept.surface.mode, contact.surface.mode) << "not rolling: both rows";
+    EXPECT_EQ(kept.surface.rho2, contact.surface.rho2);
+  }
+
+  c.spinning_friction = -1.0;  // equal coefficients: no dContactAxisDep
+  contact.surface = contact_surface(c);
+  aligned = contact;
+  align_rolling_row(aligned, {2.0, 2.0, 0.0});
+  EXPECT_NEAR(aligned.fdir1[0], std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(aligned.fdir1[1], std::sqrt(0.5), 1e-15);
+  EXPECT_EQ(aligned.surface.rho, 1e-5);
+  EXPECT_LT(aligned.surface.rho2, 0.0);
+  EXPECT_EQ(aligned.surface.rhoN, 1e-5) << "the spinning row kept";
+
+  c.rolling_friction = 0.0;
+  c.spinning_friction = 2e-5;
+  contact.surface = contact_surface(c);
+  aligned = contact;
+  align_rolling_row(aligned, {2.0, 0.0, 0.0});
+  EXPECT_EQ(aligned.surface.mode, contact.surface.mode)
+      << "no rolling resistance: nothing to align";
 }
 
 }  // namespace
