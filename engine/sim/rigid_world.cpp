@@ -524,10 +524,14 @@ void RigidWorld::create_contact_joints() {
   for (const FoundContact& f : found_) {
     const bool a_sleeps = sleeps(f.a), b_sleeps = sleeps(f.b);
     if (fixed(f.a, a_sleeps) && fixed(f.b, b_sleeps)) continue;
-    dContact contact = f.contact;
-    if (rolling_axis_aligned_)
-      align_rolling_row(contact, angular_velocity_of(f.a) - angular_velocity_of(f.b));
-    dJointID j = dJointCreateContact(world_, contacts_, &contact);
+    const dContact* contact = &f.contact;
+    dContact aligned;
+    if (rolling_axis_aligned_) {
+      aligned = f.contact;
+      align_rolling_row(aligned, angular_velocity_of(f.a) - angular_velocity_of(f.b));
+      contact = &aligned;
+    }
+    dJointID j = dJointCreateContact(world_, contacts_, contact);
     dJointAttach(j, a_sleeps ? nullptr : f.a, b_sleeps ? nullptr : f.b);
   }
   found_.clear();
