@@ -40,13 +40,6 @@ constexpr double kSkinFraction = 0.02;
 // grows with the cube of the contacts of an island).
 constexpr long kExactSolverBodies = 32;
 
-// A body's angular velocity; zero for the ground and static geoms (nullptr).
-Vec3 angular_velocity_of(dBodyID body) {
-  if (!body) return Vec3{0.0, 0.0, 0.0};
-  const dReal* w = dBodyGetAngularVel(body);
-  return Vec3{w[0], w[1], w[2]};
-}
-
 }  // namespace
 
 dSurfaceParameters contact_surface(const ContactSettings& c) {
@@ -521,6 +514,10 @@ void RigidWorld::create_contact_joints() {
   auto sleeps = [this](dBodyID b) { return b && bodies_[index_of(b)].sleeping; };
   // Neither of two such bodies moves in this step (a rider only along its path: ride).
   auto fixed = [this](dBodyID b, bool asleep) { return asleep || !b || bodies_[index_of(b)].rides; };
+  // Zero for the ground and static geoms (no body).
+  auto omega = [this](dBodyID b) {
+    return b ? angular_velocity(index_of(b)) : Vec3{0.0, 0.0, 0.0};
+  };
   for (const FoundContact& f : found_) {
     const bool a_sleeps = sleeps(f.a), b_sleeps = sleeps(f.b);
     if (fixed(f.a, a_sleeps) && fixed(f.b, b_sleeps)) continue;
@@ -528,7 +525,7 @@ void RigidWorld::create_contact_joints() {
     dContact aligned;
     if (rolling_axis_aligned_) {
       aligned = f.contact;
-      align_rolling_row(aligned, angular_velocity_of(f.a) - angular_velocity_of(f.b));
+      align_rolling_row(aligned, omega(f.a) - omega(f.b));
       contact = &aligned;
     }
     dJointID j = dJointCreateContact(world_, contacts_, contact);
