@@ -334,21 +334,15 @@ TEST(CompassNeedle, SmallAnglePeriodAndNoNetForce) {
 
 // A crane ball (8 moments, uniaxial anisotropy H_K 3.2e5 A/m) turning in a
 // uniform field of 3e5 A/m across its easy axis, weightless and touching
-// nothing: the field turns it faster and slower twice a turn (about 1100 to
-// 1300 rad/s), and nothing else acts, so its fastest speed per turn must not
-// grow (a torque update that pumped energy would raise it turn by turn; a
-// ball rolling on the crane's side face keeps such speeds for a second:
-// docs/benchmarks.md 4u). Compared over about 95 turns, after the first 0.05
-// s in which the magnetization leaves its starting state.
+// nothing (benchmarks/anisotropic_ball_turning.json): the field turns it
+// faster and slower twice a turn (about 1100 to 1300 rad/s), and nothing else
+// acts, so its fastest speed per turn must not grow (a torque update that
+// pumped energy would raise it turn by turn; a ball rolling on the crane's
+// side face keeps such speeds for a second: docs/benchmarks.md 4u). Compared
+// over about 95 turns, after the first 0.05 s in which the magnetization
+// leaves its starting state.
 TEST(AnisotropicBall, TurnsInAUniformFieldWithoutGainingEnergy) {
-  const SceneDescription scene = parse_scene(R"({
-    "gravity": [0, 0, 0], "external_field": [300000, 0, 0],
-    "materials": {"steel": {"type": "soft", "saturation": 800000, "susceptibility": 1000,
-                            "anisotropy_field": 320000, "easy_axis": [0, 0, 1], "moments_per_cell": 8}},
-    "bodies": [{"name": "ball", "shape": {"sphere": 0.005}, "material": "steel", "position": [0, 0, 0.1],
-                "angular_velocity": [0, 700, 0], "density": 7850}],
-    "simulation": {"time_step": 0.001}})",
-                                             "turning_ball.json");
+  const SceneDescription scene = load_scene(ODEMAG_SOURCE_DIR "/benchmarks/anisotropic_ball_turning.json");
   Simulation sim(scene);
   auto fastest_until = [&](double t) {
     double fastest = 0.0;
