@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/material.h"
-#include "magnetics/model.h"
-#include "magnetics/rng.h"
-#include "magnetics/state.h"
+#include "odemag/material.h"
+#include "magnetics/model/model.h"
+#include "magnetics/kernels/rng.h"
+#include "magnetics/model/state.h"
 
 namespace odemag::bench {
 

@@ -1,4 +1,4 @@
-// Cost of one field evaluation of each current source (magnetics/coil.h),
+// Cost of one field evaluation of each current source (magnetics/sources/coil.h),
 // Google Benchmark, ns per evaluation, one thread: the closed forms (loop,
 // segment, arc, solenoid sheet) and the quadratures over a cross-section (a
 // circular coil, the TEAM 20 rounded-rectangle coil) at points off and in
@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "magnetics/coil.h"
+#include "magnetics/sources/coil.h"
 
 namespace odemag {
 namespace {

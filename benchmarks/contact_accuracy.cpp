@@ -13,8 +13,8 @@
 #include <chrono>
 #include <cstdio>
 
-#include "magnetics/backend.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/relax/relax.h"
 #include "tests/support/contact_references.h"
 
 using namespace odemag;

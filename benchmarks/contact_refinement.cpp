@@ -6,7 +6,7 @@
 // A standalone Galerkin solve of two linear balls (chi, radius R, gap g R, the
 // field H0 along the line or across it), independent of the engine's relaxation: every cell
 // is a cube of edge a (h / 2^l) standing for its part of the ball
-// (volume V = w a^3, the volume-share cells of magnetics/cells.h), coupled to
+// (volume V = w a^3, the volume-share cells of magnetics/cells/cells.h), coupled to
 // every other cell by the cuboid-cuboid tensor N_ij (cuboid_demag_tensor):
 //   H_i = H0 - sum_j N_ij w_j M_j + K_i M_i,   M_i = chi H_i,
 // cubes centred on their lattice sites within a body and on their centroids
@@ -58,11 +58,11 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/cells.h"
-#include "magnetics/constants.h"
-#include "magnetics/demag_tensor.h"
-#include "magnetics/eigen_tensors.h"
-#include "magnetics/kernels.h"
+#include "magnetics/cells/cells.h"
+#include "odemag/constants.h"
+#include "magnetics/cells/demag_tensor.h"
+#include "magnetics/kernels/eigen_tensors.h"
+#include "magnetics/kernels/kernels.h"
 #include "tests/support/contact_references.h"
 
 using namespace odemag;
@@ -203,7 +203,7 @@ Result solve(double R, double h, double gap_over_R, const std::vector<double>& D
       A.block<3, 3>(3 * i, 3 * j) = w * N;
       if (a.body == b.body) sum += w * N;
     }
-    // The engine's split (magnetics/model.cpp build_boundary_correction): the
+    // The engine's split (magnetics/model/model.cpp build_boundary_correction): the
     // cell's own I/3 (gamma_D = 1/3 + 1/chi) and K_i = I/3 + sum_{j != i} w_j
     // N_ij - Nbar_i, Nbar_i = I/3 for a ball, its eigenvalues capped at (1 -
     // w_i)/3 with --cap. (Until stop 43 the cap was applied to K_i - (1 - w_i)
@@ -222,7 +222,7 @@ Result solve(double R, double h, double gap_over_R, const std::vector<double>& D
     for (int a = 0; a < 3; ++a) rhs(3 * i + a) = cells[i].volume * H0[a];
   if (options.cap) {
     // The engine's uniform-mode update of each body's own operator S_b
-    // (magnetics/model.cpp): S_b' = S_b - (S_b U)(U^T S_b U)^-1 (S_b U)^T + B (U^T B)^-1 B^T,
+    // (magnetics/model/model.cpp): S_b' = S_b - (S_b U)(U^T S_b U)^-1 (S_b U)^T + B (U^T B)^-1 B^T,
     // U the body's uniform fields, B = W beta, beta = (1/chi + 1/3) I for a ball.
     for (int body = 0; body < 2; ++body) {
       const int first = body * per_ball;

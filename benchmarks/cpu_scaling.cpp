@@ -20,8 +20,8 @@
 // GFLOP/s per core: what a shared machine's time slicing does not distort),
 // and one force evaluation.
 //
-// Flops per pair (counted from magnetics/kernels.h and the loops of
-// magnetics/cpu_backend.cpp; +, -, * one each, the inverse square root one,
+// Flops per pair (counted from magnetics/kernels/kernels.h and the loops of
+// magnetics/relax/cpu_backend.cpp; +, -, * one each, the inverse square root one,
 // the max of r^2 and s^2 not counted):
 //   field kernel (inter-body): offset 3, contact distance 1, r^2 5, s^2 1,
 //     1/r 1, powers and q 4, A 6, B 4, r.mu and B (r.mu) 6, H += 12: 43;
@@ -57,8 +57,8 @@
 
 #include "benchmarks/bench_common.h"
 #include "benchmarks/timed_backend.h"
-#include "magnetics/backend.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

@@ -30,7 +30,7 @@
 
 #include "benchmarks/bench_common.h"
 #include "engine/scene/scene.h"
-#include "engine/sim/simulation.h"
+#include "engine/simulation/simulation.h"
 
 using namespace odemag;
 

@@ -25,12 +25,12 @@
 #include <vector>
 
 #include "benchmarks/bench_common.h"
-#include "magnetics/backend.h"
-#include "magnetics/far_field.h"
-#include "magnetics/kernels.h"
-#include "magnetics/model.h"
-#include "magnetics/rng.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/relax/far_field.h"
+#include "magnetics/kernels/kernels.h"
+#include "magnetics/model/model.h"
+#include "magnetics/kernels/rng.h"
+#include "magnetics/model/state.h"
 
 using namespace odemag;
 

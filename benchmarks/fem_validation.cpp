@@ -37,9 +37,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "magnetics/backend.h"
-#include "magnetics/constants.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "odemag/constants.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

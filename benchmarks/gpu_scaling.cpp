@@ -34,9 +34,9 @@
 #include <vector>
 
 #include "gpu/cuda_backend.h"
-#include "magnetics/backend.h"
-#include "magnetics/relax.h"
-#include "magnetics/rng.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/kernels/rng.h"
 
 using namespace odemag;
 

@@ -4,7 +4,7 @@
 // patterns without any applied field. Output: CSV on stdout.
 #include <cstdio>
 
-#include "magnetics/model.h"
+#include "magnetics/model/model.h"
 #include "tests/support/magnetic_checks.h"
 
 using namespace odemag;

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "magnetics/llg.h"
+#include "magnetics/kernels/llg.h"
 
 using namespace odemag;
 

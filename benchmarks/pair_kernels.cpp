@@ -10,8 +10,8 @@
 #include <cmath>
 
 #include "benchmarks/bench_common.h"
-#include "magnetics/backend.h"
-#include "magnetics/rng.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/kernels/rng.h"
 
 namespace odemag {
 namespace {

@@ -30,11 +30,11 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/cells.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/cells/cells.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 #include "tests/support/contact_references.h"
 
 using namespace odemag;

@@ -8,7 +8,7 @@
 #include <functional>
 #include <string>
 
-#include "magnetics/relax.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "magnetics/llg.h"
-#include "magnetics/rng.h"
+#include "magnetics/kernels/llg.h"
+#include "magnetics/kernels/rng.h"
 
 using namespace odemag;
 

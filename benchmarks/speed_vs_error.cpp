@@ -36,9 +36,9 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/constants.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "odemag/constants.h"
+#include "magnetics/relax/relax.h"
 #include "tests/support/reference_fields.h"
 
 using namespace odemag;

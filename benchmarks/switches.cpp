@@ -58,10 +58,10 @@
 #include "benchmarks/bench_common.h"
 #include "benchmarks/timed_backend.h"
 #include "engine/scene/scene.h"
-#include "engine/sim/simulation.h"
-#include "magnetics/backend.h"
-#include "magnetics/demag_tensor.h"
-#include "magnetics/relax.h"
+#include "engine/simulation/simulation.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/cells/demag_tensor.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

@@ -14,10 +14,10 @@
 // team20::GradedProblem, written to DIR/STEM.csv and .md, only when given,
 // STEM team20_graded unless --graded-name says otherwise; --ampere-turns: a
 // subset of the four excitations; the Newton variable b = H + M, the
-// default, or H: magnetics/bh_lattice_solve.h; --dense: the quarter's
+// default, or H: magnetics/static/bh_lattice_solve.h; --dense: the quarter's
 // operator stored dense instead of as a hierarchical matrix, --single: the
 // hierarchical matrix in single precision; --tolerance:
-// the solve's, on |G| / |M| of magnetics/bh_lattice_solve.h, 1e-4 unless
+// the solve's, on |G| / |M| of magnetics/static/bh_lattice_solve.h, 1e-4 unless
 // given).
 // DIR: benchmarks/results. Runs itself again with OMP_WAIT_POLICY=passive
 // when that is unset.
@@ -227,12 +227,12 @@ int main(int argc, char** argv) {
                "# TEAM 20 on graded cells with mirror planes\n\n"
                "benchmarks/team20 --graded (docs/validation.md \"TEAM 20\"), " + thread_count +
                    " The quarter x, y >= 0 with its images in x = 0 and y = 0, cells h_min at the refined faces growing by "
-                   "`growth` per cell up to h_max (team20::GradedProblem), the sum of magnetics/cuboid_demag.h stored " +
+                   "`growth` per cell up to h_max (team20::GradedProblem), the sum of magnetics/static/cuboid_demag.h stored " +
                    (storage == team20::GradedProblem::Storage::dense
                         ? "dense"
                         : storage == team20::GradedProblem::Storage::compressed
-                              ? "as a hierarchical matrix (magnetics/hmatrix.h)"
-                              : "as a hierarchical matrix (magnetics/hmatrix.h) in single precision") +
+                              ? "as a hierarchical matrix (magnetics/static/hmatrix.h)"
+                              : "as a hierarchical matrix (magnetics/static/hmatrix.h) in single precision") +
                    ", the forces by stored bilinear forms (setup)." +
                    solve_line + " Cells: the whole problem's (four times the unknown cells).\n\n"
                    "| h_min / growth / h_max (mm) | cells | unknown cells |",

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/backend.h"
+#include "magnetics/model/backend.h"
 
 namespace odemag {
 

@@ -9,9 +9,9 @@
 # headers (ODEMAG_PUBLIC_HEADERS below: the embedding, scene-loading and
 # simulation headers and the magnetics headers they include) under
 # include/odemag/ with their source paths, so that
-# #include "engine/ode/magnetic_forces.h" works as in the source tree; and
+# #include "engine/embedding/magnetic_forces.h" works as in the source tree; and
 # the odemag program. Everything else is private, in particular the SIMD
-# kernels (magnetics/simd.h, pair_sums.h), whose intrinsics are chosen by the
+# kernels (magnetics/kernels/simd.h, pair_sums.h), whose intrinsics are chosen by the
 # compiler flags. odemag_warnings and odemag_tuning (-march=native) are
 # build-only: the libraries link them as $<BUILD_INTERFACE:...>, so consumers
 # compile with their own flags.
@@ -37,15 +37,15 @@ install(TARGETS odemag RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The public API: three entry headers and what they include (closed under
 # #include; tests/install/install_test.cmake checks that).
 set(ODEMAG_PUBLIC_HEADERS
-  engine/ode/magnetic_forces.h engine/ode/force_accumulator.h       # embedding
-  engine/ode/magnetic_stepper.h engine/ode/substeps.h engine/ode/exact_step.h
+  engine/embedding/magnetic_forces.h engine/embedding/force_accumulator.h       # embedding
+  engine/embedding/magnetic_stepper.h engine/embedding/substeps.h engine/embedding/exact_step.h
   engine/scene/scene.h                                              # scene loading
-  engine/sim/simulation.h engine/sim/rigid_world.h engine/sim/frame_writer.h
-  engine/sim/magnetic_system.h engine/sim/outcomes.h engine/sim/solve.h engine/sim/winding_solids.h  # simulation
+  engine/simulation/simulation.h engine/simulation/rigid_world.h engine/simulation/frame_writer.h
+  engine/simulation/magnetic_system.h engine/simulation/outcomes.h engine/simulation/solve.h engine/simulation/winding_solids.h  # simulation
   gpu/cuda_backend.h
-  magnetics/backend.h magnetics/cells.h magnetics/constants.h magnetics/demag_tensor.h
-  magnetics/bh_curve.h magnetics/body_response.h magnetics/coil.h magnetics/hd.h magnetics/llg.h magnetics/material.h magnetics/model.h magnetics/relax.h
-  magnetics/rng.h magnetics/shape.h magnetics/small_eigen.h magnetics/state.h magnetics/vec3.h)
+  magnetics/model/backend.h magnetics/cells/cells.h include/odemag/constants.h magnetics/cells/demag_tensor.h
+  magnetics/materials/bh_curve.h magnetics/model/body_response.h magnetics/sources/coil.h magnetics/kernels/hd.h magnetics/kernels/llg.h include/odemag/material.h magnetics/model/model.h magnetics/relax/relax.h
+  magnetics/kernels/rng.h include/odemag/shape.h magnetics/kernels/small_eigen.h magnetics/model/state.h include/odemag/vec3.h)
 foreach(header IN LISTS ODEMAG_PUBLIC_HEADERS)
   get_filename_component(dir ${header} DIRECTORY)
   install(FILES ${PROJECT_SOURCE_DIR}/${header} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/odemag/${dir})

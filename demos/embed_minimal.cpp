@@ -10,8 +10,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "engine/ode/magnetic_forces.h"
-#include "engine/ode/magnetic_stepper.h"
+#include "engine/embedding/magnetic_forces.h"
+#include "engine/embedding/magnetic_stepper.h"
 
 static dWorldID world;
 static dJointGroupID contacts;

@@ -4,7 +4,7 @@
 // cell order. The per-body sums run on the host in the CPU backend's order.
 #include "gpu/cuda_check.cuh"
 #include "gpu/device_data.cuh"
-#include "magnetics/kernels.h"
+#include "magnetics/kernels/kernels.h"
 
 namespace odemag::gpu {
 

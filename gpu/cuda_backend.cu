@@ -35,10 +35,10 @@
 #include "gpu/cuda_check.cuh"
 #include "gpu/device_buffer.cuh"
 #include "gpu/device_data.cuh"
-#include "magnetics/cell_layout.h"
-#include "magnetics/field_probe.h"
-#include "magnetics/near_field.h"
-#include "magnetics/state.h"
+#include "magnetics/model/cell_layout.h"
+#include "magnetics/relax/field_probe.h"
+#include "magnetics/near_field/near_field.h"
+#include "magnetics/model/state.h"
 
 namespace odemag {
 
@@ -193,7 +193,7 @@ class CudaBackend final : public MagneticBackend {
       d.kind = static_cast<int>(body.kind);
     }
 
-    // Cell lists in the order of the shared layout (magnetics/cell_layout.h),
+    // Cell lists in the order of the shared layout (magnetics/model/cell_layout.h),
     // the CPU backend's order.
     layout_.build(model, state);
     resp_soft_.clear(), all_positions_.clear(), moment_runs_.clear();
@@ -284,7 +284,7 @@ class CudaBackend final : public MagneticBackend {
     timer.synchronize(up, 0.0);
     timer.stop();
     // Near-field corrections: short pair lists, evaluated on the host with
-    // the same code as the CPU backend (magnetics/near_field.h).
+    // the same code as the CPU backend (magnetics/near_field/near_field.h).
     near_.build(model, state, near_field_, near_mutual_induction_);
   }
 

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "magnetics/backend.h"
+#include "magnetics/model/backend.h"
 
 namespace odemag {
 

@@ -4,7 +4,7 @@
 // kernels call the shared host/device formulas of magnetics/ (kernels.h,
 // llg.h, cell_field.h), so both backends evaluate one copy of each formula.
 //
-// Cell lists, as in the CPU backend (magnetics/cpu_backend.cpp), ordered by
+// Cell lists, as in the CPU backend (magnetics/relax/cpu_backend.cpp), ordered by
 // body and, within a body, by cell:
 //   responsive: cells of active soft and recoil bodies (targets and sources of
 //               the responsive field, the cells relax_cells updates);
@@ -16,9 +16,9 @@
 
 #include <cstdint>
 
-#include "magnetics/cell_field.h"
-#include "magnetics/llg.h"
-#include "magnetics/vec3.h"
+#include "magnetics/kernels/cell_field.h"
+#include "magnetics/kernels/llg.h"
+#include "odemag/vec3.h"
 
 namespace odemag::gpu {
 

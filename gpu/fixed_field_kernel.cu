@@ -4,7 +4,7 @@
 // summing them in source order, so the result does not depend on scheduling.
 #include "gpu/cuda_check.cuh"
 #include "gpu/device_data.cuh"
-#include "magnetics/kernels.h"
+#include "magnetics/kernels/kernels.h"
 
 namespace odemag::gpu {
 

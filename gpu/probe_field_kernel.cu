@@ -1,5 +1,5 @@
 // probe_field: one thread per point, summing H_E and probe_cell_field of
-// every probe cell (magnetics/field_probe.h builds the list on the host) in
+// every probe cell (magnetics/relax/field_probe.h builds the list on the host) in
 // list order, as the CPU backend does. Every thread of a warp reads the same
 // cell at the same time, so the loads are broadcasts served by the cache.
 #include "gpu/cuda_check.cuh"

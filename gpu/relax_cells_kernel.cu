@@ -1,12 +1,12 @@
 // relax_cells: one thread per responsive cell. Soft cells relax their moments
 // under the frozen applied field with relax_soft_cell (LLG steps, then the
-// Newton polish; magnetics/llg.h), recoil magnets take
+// Newton polish; magnetics/kernels/llg.h), recoil magnets take
 // recoil_magnetization. The moments, Hc history and noise counters stay in
 // device memory; the backend copies them to the host state after the call.
 #include "gpu/cuda_check.cuh"
 #include "gpu/device_data.cuh"
-#include "magnetics/model.h"
-#include "magnetics/rng.h"
+#include "magnetics/model/model.h"
+#include "magnetics/kernels/rng.h"
 
 namespace odemag::gpu {
 

@@ -8,7 +8,7 @@
 // bodies with partial cells is added on the host (add_boundary_field).
 #include "gpu/cuda_check.cuh"
 #include "gpu/device_data.cuh"
-#include "magnetics/kernels.h"
+#include "magnetics/kernels/kernels.h"
 
 namespace odemag::gpu {
 

@@ -23,8 +23,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "magnetics/bh_curve.h"
-#include "magnetics/constants.h"
+#include "magnetics/materials/bh_curve.h"
+#include "odemag/constants.h"
 
 namespace odemag {
 
@@ -823,7 +823,7 @@ BodyDescription read_body(const SceneReader& r, const json& v, const std::string
   read_object(r, v, path, kBodyKeys, t);
   BodyDescription& body = t.body;
 
-  // The lattice must stay a sensible size (magnetics/model.h).
+  // The lattice must stay a sensible size (magnetics/model/model.h).
   const double h = lattice_spacing(body, scene.cell_size);
   if (h > 0.0 && !is_inert(scene.materials.at(body.material)))
     if (std::string e = validate_body_lattice(body.name, body.shape, h); !e.empty())

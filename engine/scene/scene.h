@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/coil.h"
-#include "magnetics/material.h"
-#include "magnetics/relax.h"
-#include "magnetics/shape.h"
-#include "magnetics/vec3.h"
+#include "magnetics/sources/coil.h"
+#include "odemag/material.h"
+#include "magnetics/relax/relax.h"
+#include "odemag/shape.h"
+#include "odemag/vec3.h"
 
 namespace odemag {
 
@@ -72,7 +72,7 @@ struct SolverSettings {
   // docs/model.md "Graded cells"); CPU backend only ("auto" then picks it).
   bool graded_cells = false;
   // Refined contact zones for lattice balls near other bodies at the scene's
-  // poses (engine/sim/magnetic_system.h scene_contact_zones, docs/model.md
+  // poses (engine/simulation/magnetic_system.h scene_contact_zones, docs/model.md
   // "Refined contact zones"); CPU backend only.
   bool contact_refinement = false;
 };

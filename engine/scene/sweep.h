@@ -2,7 +2,7 @@
 // overrides by key path into its JSON ("materials.steel.susceptibility",
 // "bodies[3].position[2]"), as a grid or a list of variants. This is the one
 // place that reads specs and builds variant scenes; `odemag sweep`
-// (demos/cli/sweep.cpp) runs them, and the Dask runner (python/odemag/sweeps.py)
+// (cli/sweep.cpp) runs them, and the Dask runner (python/odemag/sweeps.py)
 // gets them from it.
 #pragma once
 

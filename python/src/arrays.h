@@ -9,7 +9,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "magnetics/vec3.h"
+#include "odemag/vec3.h"
 
 namespace odemag::python {
 

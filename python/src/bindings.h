@@ -9,7 +9,7 @@
 #include <string>
 
 #include "engine/scene/scene.h"
-#include "magnetics/backend.h"
+#include "magnetics/model/backend.h"
 
 namespace odemag::python {
 

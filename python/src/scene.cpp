@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/sim/magnetic_system.h"
-#include "engine/sim/solve.h"
+#include "engine/simulation/magnetic_system.h"
+#include "engine/simulation/solve.h"
 #include "python/src/arrays.h"
 #include "python/src/bindings.h"
 

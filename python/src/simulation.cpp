@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/sim/magnetic_system.h"
-#include "engine/sim/simulation.h"
+#include "engine/simulation/magnetic_system.h"
+#include "engine/simulation/simulation.h"
 #include "python/src/arrays.h"
 #include "python/src/bindings.h"
 

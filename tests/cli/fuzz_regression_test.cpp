@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "demos/cli/cli.h"
+#include "cli/cli.h"
 #include "engine/scene/scene.h"
 
 namespace odemag {

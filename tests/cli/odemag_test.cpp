@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "magnetics/constants.h"
-#include "magnetics/vec3.h"
+#include "odemag/constants.h"
+#include "odemag/vec3.h"
 #include "tests/support/contact_references.h"
 #include "tests/support/program_run.h"
 
@@ -248,7 +248,7 @@ TEST_F(Cli, ContactRefinementKeyRefinesTouchingLatticeBalls) {
 }
 
 // A run whose refined contact slides away from its zones moves them (the
-// rule: engine/sim Simulation.ContactZonesFollowASlidingBall) and counts it
+// rule: engine/simulation Simulation.ContactZonesFollowASlidingBall) and counts it
 // in summary.json "rezoned", with no notice.
 TEST_F(Cli, RunMovesRefinedZonesWithTheContacts) {
   const fs::path scene = write("sliding.json", R"({"gravity": [0, 0, 0],

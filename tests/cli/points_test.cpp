@@ -1,7 +1,7 @@
 // The points file of `odemag field` and the argument parser of the commands.
 #include <gtest/gtest.h>
 
-#include "demos/cli/cli.h"
+#include "cli/cli.h"
 #include "engine/scene/scene.h"
 
 namespace odemag::cli {

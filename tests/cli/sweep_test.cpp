@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "demos/cli/cli.h"
+#include "cli/cli.h"
 #include "engine/scene/sweep.h"
 #include "tests/support/program_run.h"
 

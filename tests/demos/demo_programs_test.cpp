@@ -1,4 +1,4 @@
-// The demo programs' command lines (demos/programs): --help prints the usage
+// The demo programs' command lines (demos): --help prints the usage
 // and a bad command line exits 2 with one stderr line, neither writing
 // anything; demo_magnetization_curve writes its CSV and reports the PNG only
 // when gnuplot (run without a shell) wrote one. The long demo_paper_scenes

@@ -19,10 +19,10 @@
 #include <variant>
 
 #include "engine/scene/scene.h"
-#include "engine/sim/simulation.h"
-#include "magnetics/backend.h"
-#include "magnetics/coil.h"
-#include "magnetics/constants.h"
+#include "engine/simulation/simulation.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/sources/coil.h"
+#include "odemag/constants.h"
 #include "tests/support/windings.h"
 
 namespace odemag {

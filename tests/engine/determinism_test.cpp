@@ -20,7 +20,7 @@
 //
 // Re-pinned (stop 13) for the faster sphere near field (one knot search for
 // the ten tabulated series, reciprocals for divisions, a pair's two fields in
-// one pass; magnetics/sphere_near_field.cpp): the same formulas in another
+// one pass; magnetics/near_field/sphere_near_field.cpp): the same formulas in another
 // order, so rounding differs; `odemag solve` of the paper scenes agrees with
 // the previous build to within the relaxation tolerance (largest relative
 // change of a body's moment or force 7e-6 at tolerance 1e-4, crane_small),
@@ -28,15 +28,15 @@
 // plate, without one-cell sphere pairs, kept its hash.
 //
 // Re-pinned (stop 15) for two physics changes: the near field of a one-cell
-// ball next to a lattice body (magnetics/ball_lattice_near_field.cpp: the
+// ball next to a lattice body (magnetics/near_field/ball_lattice_near_field.cpp: the
 // cells' cube fields instead of point dipoles within 3 h; every pinned scene
 // has balls touching a lattice magnet or plate), and the anisotropy energy of
-// the Newton polish's line search summed as |m x e|^2 (magnetics/llg.h; it
+// the Newton polish's line search summed as |m x e|^2 (magnetics/kernels/llg.h; it
 // alone moved nail_and_balls). Outcomes: docs/scenes.md "stop 15".
 //
 // Re-pinned (stop 16) for the substep rule: a body in contact travels at
 // most a tenth of its size per substep with its own velocity
-// (engine/ode/substeps.cpp; the 0.3 contact allowance let two lattice
+// (engine/embedding/substeps.cpp; the 0.3 contact allowance let two lattice
 // magnets started at one centre spin apart and reach 5.8% of their half
 // extent into the floor). Only nail_and_balls moved.
 // Outcomes: docs/scenes.md "stop 16".
@@ -47,7 +47,7 @@
 // moved; their outcomes did not (docs/scenes.md "stop 17").
 // Re-pinned (stop 26) for carried-over ball-lattice pairs: a ball that moved
 // less than 1e-4 R in a lattice body's frame keeps its pairs, carried to its
-// new offset to first order (magnetics/ball_lattice_near_field.cpp; fields
+// new offset to first order (magnetics/near_field/ball_lattice_near_field.cpp; fields
 // off by ~1e-10, forces by ~1e-5 of the correction), and the pair's point
 // dipole terms share one coefficient evaluation (ball_chain, iron_plate and
 // thin_iron_plate moved); and the residual's field scale floored at 1e-6 of
@@ -56,26 +56,26 @@
 // iteration cap), which moves convergence decisions of weak cells in every
 // scene. Outcomes in docs/scenes.md "stop 26".
 // Re-pinned (stop 27) for the outer loop's block preconditioner
-// (magnetics/body_response.h): the iron plates (chi = 5000, 105 and 156
+// (magnetics/model/body_response.h): the iron plates (chi = 5000, 105 and 156
 // cells) converge in fewer iterations to the same fixed point within the
 // tolerance, so their numbers round differently; iron_plate and
 // thin_iron_plate moved, ball_chain and nail_and_balls (no body takes it)
 // kept their hashes. Outcomes in docs/scenes.md "stop 27".
 // Re-pinned (stop 28) for the lattice near field's forces taking the tensors
-// of its build (magnetics/lattice_near_field.cpp): the same arithmetic, but
+// of its build (magnetics/near_field/lattice_near_field.cpp): the same arithmetic, but
 // the compiler contracts a few products into FMAs differently (built with
 // -ffp-contract=off, the old and the new code give identical hashes in every
 // scene); iron_plate and thin_iron_plate moved.
 // Re-pinned (stop 29) for carried-over sphere pairs: a pair of one-cell
 // spheres whose centre distance moved by at most 1e-5 of its gap (and of
 // R_a + R_b) since its coefficients were evaluated keeps them, K carried to
-// first order (magnetics/sphere_near_field.cpp; fields off by ~1e-10, forces
+// first order (magnetics/near_field/sphere_near_field.cpp; fields off by ~1e-10, forces
 // by ~2.5e-6 of a close pair's force). Every scene with sphere pairs
 // moved (ball_chain, thin_iron_plate, nail_and_balls); iron_plate, without
 // them, kept its hash. Outcomes in docs/scenes.md "stop 29".
 // Re-pinned (stop 32) for the predicted warm start: the outer loop starts
 // from the warm start plus the last relaxation's change of a cell's applied
-// field where the last two relaxations changed it alike (magnetics/relax.cpp,
+// field where the last two relaxations changed it alike (magnetics/relax/relax.cpp,
 // docs/model.md "Predicted warm start"). The same fixed points to the
 // tolerance, reached from other first iterates in fewer iterations, so every
 // scene's iterates and rounding moved (all four). Outcomes in docs/scenes.md
@@ -83,9 +83,9 @@
 // Re-pinned (stop 46) for cheaper near-field builds (issue 14): sphere pairs
 // carried to second order within 1e-2 of their gap (fields off by ~6e-9,
 // forces by ~6e-6 of a close pair's force) from a pair list kept while no
-// sphere moved 0.2 R (magnetics/sphere_near_field.cpp), and ball-lattice
+// sphere moved 0.2 R (magnetics/near_field/sphere_near_field.cpp), and ball-lattice
 // pairs carried within 1e-3 R instead of 1e-4 R (fields ~1e-8, forces
-// ~1.2e-4 of the correction; magnetics/ball_lattice_near_field.cpp). Every
+// ~1.2e-4 of the correction; magnetics/near_field/ball_lattice_near_field.cpp). Every
 // scene has such pairs and moved (all four); then the ball-lattice pairs'
 // carried window and T_c kept beside their evaluation instead of in a copy
 // of it (the same formulas; the compiler contracts products into FMAs
@@ -99,8 +99,8 @@
 #include <string>
 
 #include "engine/scene/scene.h"
-#include "engine/sim/simulation.h"
-#include "magnetics/backend.h"
+#include "engine/simulation/simulation.h"
+#include "magnetics/model/backend.h"
 
 namespace odemag {
 namespace {

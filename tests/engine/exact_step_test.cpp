@@ -1,4 +1,4 @@
-// ODE's exact solver on a contact set it fails on (engine/ode/exact_step.h,
+// ODE's exact solver on a contact set it fails on (engine/embedding/exact_step.h,
 // docs/simulation.md "Contacts"): three steel balls in a row on the floor,
 // the middle one touched from above by a kinematic body, as the
 // nail_and_balls scene met them (recorded from that run, every number as
@@ -15,7 +15,7 @@
 #include <cmath>
 #include <vector>
 
-#include "engine/ode/exact_step.h"
+#include "engine/embedding/exact_step.h"
 
 namespace odemag {
 namespace {

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <vector>
 
-#include "engine/sim/simulation.h"
-#include "magnetics/constants.h"
+#include "engine/simulation/simulation.h"
+#include "odemag/constants.h"
 #include "tests/support/scene_builders.h"
 
 namespace odemag {

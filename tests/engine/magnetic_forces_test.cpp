@@ -1,9 +1,9 @@
-// The embedding API (engine/ode/magnetic_forces.h): bad body indices throw,
+// The embedding API (engine/embedding/magnetic_forces.h): bad body indices throw,
 // and magnetics built from a scene and bound to ODE bodies (the simulation's
 // path) give the same forces as the same bodies attached one by one (an
 // embedder's path). Input checks (lattice limit, finite poses and fields) and
 // the wake-up of bodies ODE put to sleep.
-#include "engine/ode/magnetic_forces.h"
+#include "engine/embedding/magnetic_forces.h"
 
 #include <gtest/gtest.h>
 #include <ode/ode.h>
@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "engine/scene/scene.h"
-#include "engine/sim/magnetic_system.h"
-#include "magnetics/backend.h"
-#include "magnetics/cells.h"
-#include "magnetics/constants.h"
+#include "engine/simulation/magnetic_system.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/cells/cells.h"
+#include "odemag/constants.h"
 #include "tests/support/contact_references.h"
 
 namespace odemag {

@@ -1,4 +1,4 @@
-// The embedder's substepping (engine/ode/magnetic_stepper.h, docs/embedding.md
+// The embedder's substepping (engine/embedding/magnetic_stepper.h, docs/embedding.md
 // "Substeps"): the world of demos/embed_minimal.cpp, an iron ball pulled to a
 // bar magnet's pole, stepped with MagneticStepper ends with the ball resting
 // on the magnet, where the plain loop (apply(); collide; quickstep) either
@@ -13,10 +13,10 @@
 #include <limits>
 #include <stdexcept>
 
-#include "engine/ode/magnetic_forces.h"
-#include "engine/ode/magnetic_stepper.h"
-#include "engine/ode/substeps.h"
-#include "magnetics/constants.h"
+#include "engine/embedding/magnetic_forces.h"
+#include "engine/embedding/magnetic_stepper.h"
+#include "engine/embedding/substeps.h"
+#include "odemag/constants.h"
 
 namespace odemag {
 namespace {
@@ -101,7 +101,7 @@ constexpr double kTouching = 1e-3 * kRadius;
 // contact now and then (in 79 of 1000 steps here), and the pull then moves the
 // ball a h^2 into the magnet for one step (1.7 mm at 1 ms, about a third of
 // its radius) before the contact pushes it out: the substep rule allows that
-// travel for a body in contact (0.3 of its size, engine/ode/substeps.cpp).
+// travel for a body in contact (0.3 of its size, engine/embedding/substeps.cpp).
 TEST(MagneticStepper, EmbedMinimalBallRestsOnTheMagnet) {
   EmbedWorld w(0.0);
   MagneticStepper stepper = w.stepper();

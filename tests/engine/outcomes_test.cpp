@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "engine/sim/simulation.h"
-#include "magnetics/constants.h"
+#include "engine/simulation/simulation.h"
+#include "odemag/constants.h"
 #include "tests/support/scene_builders.h"
 
 namespace odemag {

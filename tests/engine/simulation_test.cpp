@@ -1,7 +1,7 @@
 // Rigid bodies with ODE (issue 3 "What it must show"): a ball comes to rest
 // on a magnet at 1, 4 and 10 ms steps; a compass needle's period in a uniform
 // field; momentum conservation of two attracting magnets; time-line events.
-#include "engine/sim/simulation.h"
+#include "engine/simulation/simulation.h"
 
 #include <gtest/gtest.h>
 
@@ -10,11 +10,11 @@
 #include <cstdio>
 #include <string>
 
-#include "engine/sim/magnetic_system.h"
-#include "engine/sim/rigid_world.h"
-#include "magnetics/backend.h"
-#include "magnetics/constants.h"
-#include "magnetics/relax.h"
+#include "engine/simulation/magnetic_system.h"
+#include "engine/simulation/rigid_world.h"
+#include "magnetics/model/backend.h"
+#include "odemag/constants.h"
+#include "magnetics/relax/relax.h"
 #include "tests/support/scene_builders.h"
 
 namespace odemag {

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "engine/sim/simulation.h"
+#include "engine/simulation/simulation.h"
 #include "tests/support/scene_builders.h"
 
 namespace odemag {

@@ -1,7 +1,7 @@
-// The windings of coils as collision solids (engine/sim/winding_solids.h):
+// The windings of coils as collision solids (engine/simulation/winding_solids.h):
 // which points they cover, against the windings' definitions written here,
 // and bodies that meet them in a simulation.
-#include "engine/sim/winding_solids.h"
+#include "engine/simulation/winding_solids.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <cmath>
 #include <random>
 
-#include "engine/sim/simulation.h"
-#include "magnetics/constants.h"
+#include "engine/simulation/simulation.h"
+#include "odemag/constants.h"
 #include "tests/support/scene_builders.h"
 #include "tests/support/windings.h"
 
@@ -85,7 +85,7 @@ TEST(WindingSolids, CoverACircularCoilsCopperAndLeaveItsBoreOpen) {
 }
 
 // The rounded rectangle: the points at distance inner..outer corner radius
-// from the core rectangle, |w| <= height / 2 (magnetics/coil.h).
+// from the core rectangle, |w| <= height / 2 (magnetics/sources/coil.h).
 TEST(WindingSolids, CoverARoundedRectangleCoilsCopperAndLeaveItsCoreFree) {
   RoundedRectangleCoil c;
   c.centre = {0.0, 0.01, -0.02};

@@ -23,12 +23,12 @@
 #include <string>
 #include <vector>
 
-#include "engine/sim/magnetic_system.h"
+#include "engine/simulation/magnetic_system.h"
 #include "gpu/cuda_backend.h"
-#include "magnetics/backend.h"
-#include "magnetics/near_field.h"
-#include "magnetics/relax.h"
-#include "magnetics/rng.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/near_field/near_field.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/kernels/rng.h"
 #include "tests/support/test_math.h"
 
 namespace odemag {
@@ -482,7 +482,7 @@ TEST(CudaParity, MagneticStepsWithoutMutualInduction) {
   check_steps(o, 2, kStepTolerance);
 }
 
-// The near-field corrections (magnetics/near_field.h) run on the host with
+// The near-field corrections (magnetics/near_field/near_field.h) run on the host with
 // the same code for both backends; the workshop has close sphere pairs
 // (ball_a and ball_b overlap, the nickel ball and the ball magnet), so the
 // steps above compare them. Here: that it does, and the point-dipole model
@@ -749,7 +749,7 @@ TEST(CudaParity, HeapOf2000CellsRelaxes) {
 }
 
 // Lattice bodies of every responsive kind: a soft lattice ball (partial
-// cells: the boundary correction of magnetics/model.cpp), a rotated soft
+// cells: the boundary correction of magnetics/model/model.cpp), a rotated soft
 // lattice box with two moments per cell and anisotropy, a recoil lattice
 // magnet, beside a fixed lattice magnet.
 void build_lattices(Scene& s) {
@@ -875,7 +875,7 @@ TEST(CudaBackend, IgnoredFarFieldIsReportedOnce) {
 }
 
 // Models that are copies of one another, or a model replaced by a new one at
-// the same address, are told apart by their generation (magnetics/model.h):
+// the same address, are told apart by their generation (magnetics/model/model.h):
 // the offset tensor tables follow.
 TEST(CudaCoherence, CopiedAndReplacedModels) {
   CUDA_BACKEND_OR_SKIP(cuda);

@@ -1,4 +1,4 @@
-// Coils carried by bodies (MagneticModel::add_coil, magnetics/relax.cpp): the
+// Coils carried by bodies (MagneticModel::add_coil, magnetics/relax/relax.cpp): the
 // field they add to the applied field, the force and torque they exert on
 // magnets and iron, and the reaction on the carrying body. References written
 // here: the on-axis field of a loop, H_z = N I R^2 / (2 (R^2 + z^2)^(3/2)),
@@ -10,12 +10,12 @@
 #include <memory>
 #include <stdexcept>
 
-#include "magnetics/backend.h"
-#include "magnetics/coil.h"
-#include "magnetics/kernels.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/sources/coil.h"
+#include "magnetics/kernels/kernels.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 #include "tests/support/test_math.h"
 
 namespace odemag {

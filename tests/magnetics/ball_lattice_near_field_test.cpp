@@ -1,4 +1,4 @@
-// The ball-lattice near field (magnetics/ball_lattice_near_field.cpp): a
+// The ball-lattice near field (magnetics/near_field/ball_lattice_near_field.cpp): a
 // one-cell ball next to a lattice body couples with each close cell as with
 // the cell's cube, not a point dipole. Checked against the field of a
 // uniformly magnetized box computed here by brute-force quadrature of its
@@ -13,12 +13,12 @@
 #include <memory>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/cell_field.h"
-#include "magnetics/model.h"
-#include "magnetics/near_field.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/kernels/cell_field.h"
+#include "magnetics/model/model.h"
+#include "magnetics/near_field/near_field.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 #include "tests/support/magnetic_checks.h"
 
 namespace odemag {
@@ -98,7 +98,7 @@ Vec3 dipole_force_in(const FieldAndGradient& f, const Vec3& mu) {
 }
 
 // ---------------------------------------------------------------------------
-// The cube tensor's gradient (magnetics/cell_field.h) against central
+// The cube tensor's gradient (magnetics/kernels/cell_field.h) against central
 // differences of the tensor, at points outside the cube: generic, near a
 // face, beyond the line of an edge (where a ball above a lattice vertex
 // sits) and beyond a corner.

@@ -1,4 +1,4 @@
-// B-H curves (magnetics/bh_curve.h, docs/model.md "B-H curves"): the monotone
+// B-H curves (magnetics/materials/bh_curve.h, docs/model.md "B-H curves"): the monotone
 // interpolation of a table, and a soft cell of such a material in a uniform
 // field, against M = M(H0 - M/3) solved here by bisection on the analytic
 // curve the table was sampled from (M = Ms tanh(H / H1)), not on the table.
@@ -9,12 +9,12 @@
 #include <stdexcept>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/bh_curve.h"
-#include "magnetics/constants.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/materials/bh_curve.h"
+#include "odemag/constants.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 
 namespace odemag {
 namespace {

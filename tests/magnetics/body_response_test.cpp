@@ -1,4 +1,4 @@
-// The outer loop's block preconditioner (magnetics/body_response.h): the
+// The outer loop's block preconditioner (magnetics/model/body_response.h): the
 // factored linear self-response of a high-chi isotropic lattice body.
 //  - The factor inverts I - J for the operator the backend really applies:
 //    J y is computed here by the CPU backend's responsive field of the body
@@ -16,10 +16,10 @@
 #include <random>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/body_response.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/body_response.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

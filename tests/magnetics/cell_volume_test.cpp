@@ -1,7 +1,7 @@
 // Per-cell volumes on curved surfaces (docs/model.md "Cells"): for balls and
 // cylinders every lattice cube that reaches into the body is a cell standing
 // for its part inside (its volume, at its centroid), and responsive ones get the boundary correction
-// of the intra-body field (magnetics/model.cpp). Checked against independent
+// of the intra-body field (magnetics/model/model.cpp). Checked against independent
 // references: the continuum sphere's moment in a uniform field, the exact
 // multipole force between a linear sphere and a point dipole, and the Bessel
 // integral force between coaxial uniformly magnetized cylinders
@@ -14,11 +14,11 @@
 #include <memory>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/cells.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/cells/cells.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 #include "tests/support/contact_references.h"
 #include "tests/support/magnetic_checks.h"
 
@@ -351,7 +351,7 @@ TEST(CellVolume, CoaxialCylinderForceConverges) {
 
 // 9. The same cylinders with the default settings (the near field on: close
 // cells of the two aligned lattices couple as cubes centred on their points,
-// magnetics/lattice_near_field.cpp), down to a 0.2 mm gap (R/h 3 .. 8: 0.95%
+// magnetics/near_field/lattice_near_field.cpp), down to a 0.2 mm gap (R/h 3 .. 8: 0.95%
 // falling to 0.47% there; within 0.11% at 1 and 2 mm, where the cells' error
 // is below the near field's own, not monotone at that level).
 TEST(CellVolume, CoaxialCylinderForceWithTheNearField) {

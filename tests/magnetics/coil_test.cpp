@@ -1,4 +1,4 @@
-// Current sources (magnetics/coil.h) against references written here,
+// Current sources (magnetics/sources/coil.h) against references written here,
 // independently of the library: closed forms (loop and solenoid on the axis,
 // infinite wire, point dipole, mutual inductance of coaxial loops), brute-force
 // Biot-Savart quadrature of dl x r / r^3 (this file's own Gauss-Legendre and
@@ -13,9 +13,9 @@
 #include <functional>
 #include <vector>
 
-#include "magnetics/coil.h"
-#include "magnetics/constants.h"
-#include "magnetics/vec3.h"
+#include "magnetics/sources/coil.h"
+#include "odemag/constants.h"
+#include "odemag/vec3.h"
 
 namespace odemag {
 namespace {

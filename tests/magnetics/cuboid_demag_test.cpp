@@ -1,5 +1,5 @@
 // The dense cuboid-cell demagnetizing field with mirror planes
-// (magnetics/cuboid_demag.h): the quarter with its images against the whole
+// (magnetics/static/cuboid_demag.h): the quarter with its images against the whole
 // problem built cell by cell, a uniformly magnetized cube of unequal cells
 // against its demagnetizing factor 1/3 (exact for the volume-averaged
 // field), and the B-H solve on a quarter against the same solve on the whole.
@@ -9,13 +9,13 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "magnetics/bh_curve.h"
-#include "magnetics/bh_lattice_solve.h"
-#include "magnetics/constants.h"
-#include "magnetics/cuboid_demag.h"
-#include "magnetics/demag_tensor.h"
-#include "magnetics/kernels.h"
-#include "magnetics/rng.h"
+#include "magnetics/materials/bh_curve.h"
+#include "magnetics/static/bh_lattice_solve.h"
+#include "odemag/constants.h"
+#include "magnetics/static/cuboid_demag.h"
+#include "magnetics/cells/demag_tensor.h"
+#include "magnetics/kernels/kernels.h"
+#include "magnetics/kernels/rng.h"
 
 namespace odemag {
 namespace {

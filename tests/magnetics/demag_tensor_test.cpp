@@ -1,6 +1,6 @@
-// The intra-body tensors (magnetics/demag_tensor.h): exact properties of the
+// The intra-body tensors (magnetics/cells/demag_tensor.h): exact properties of the
 // cube-cube demagnetising tensor, and the stability that motivates it.
-#include "magnetics/demag_tensor.h"
+#include "magnetics/cells/demag_tensor.h"
 
 #include <gtest/gtest.h>
 
@@ -12,9 +12,9 @@
 #include <limits>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/kernels.h"
-#include "magnetics/model.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/kernels/kernels.h"
+#include "magnetics/model/model.h"
 #include "tests/support/magnetic_checks.h"
 
 namespace odemag {

@@ -12,12 +12,12 @@
 #include <memory>
 #include <stdexcept>
 
-#include "magnetics/backend.h"
-#include "magnetics/kernels.h"
-#include "magnetics/material.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/kernels/kernels.h"
+#include "odemag/material.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 #include "tests/support/contact_references.h"
 
 namespace odemag {

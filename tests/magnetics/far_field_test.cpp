@@ -1,4 +1,4 @@
-// The far-field tree (magnetics/far_field.h) against the exact pair sum, and
+// The far-field tree (magnetics/relax/far_field.h) against the exact pair sum, and
 // the relaxation with the approximation on against the exact one.
 #include <gtest/gtest.h>
 
@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/far_field.h"
-#include "magnetics/kernels.h"
-#include "magnetics/material.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
-#include "magnetics/shape.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/relax/far_field.h"
+#include "magnetics/kernels/kernels.h"
+#include "odemag/material.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "odemag/shape.h"
 
 using namespace odemag;
 

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 #include "tests/support/reference_fields.h"
 
 namespace odemag {
@@ -246,7 +246,7 @@ struct LatticeCase {
 // and chi_r = 1e-12, whose own fields are negligible); `probe` is
 // field_at_points (the exact fields of the lattice cubes); `relaxation` the
 // applied field at the probes with the default options, where the near field
-// of a one-cell ball next to a lattice body (magnetics/ball_lattice_near_field.cpp)
+// of a one-cell ball next to a lattice body (magnetics/near_field/ball_lattice_near_field.cpp)
 // replaces the point dipoles of the cells within 3 h by their cubes' fields.
 struct LatticeErrors {
   std::vector<double> dipole, probe, relaxation;

@@ -6,9 +6,9 @@
 
 #include <cmath>
 
-#include "magnetics/backend.h"
-#include "magnetics/kernels.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/kernels/kernels.h"
+#include "magnetics/relax/relax.h"
 #include "tests/support/magnetic_checks.h"
 
 namespace odemag {

@@ -10,10 +10,10 @@
 #include <memory>
 #include <stdexcept>
 
-#include "magnetics/backend.h"
-#include "magnetics/constants.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "odemag/constants.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

@@ -1,4 +1,4 @@
-// The compressed operator (magnetics/hmatrix.h, CuboidDemag::compress):
+// The compressed operator (magnetics/static/hmatrix.h, CuboidDemag::compress):
 // its field against the dense sum on cells far enough apart for low-rank
 // blocks, the tolerance controlling the error, the blocks in single
 // precision, the same field bit for bit on one and two threads, and a B-H
@@ -10,10 +10,10 @@
 #include <cmath>
 #include <vector>
 
-#include "magnetics/bh_curve.h"
-#include "magnetics/bh_lattice_solve.h"
-#include "magnetics/cuboid_demag.h"
-#include "magnetics/rng.h"
+#include "magnetics/materials/bh_curve.h"
+#include "magnetics/static/bh_lattice_solve.h"
+#include "magnetics/static/cuboid_demag.h"
+#include "magnetics/kernels/rng.h"
 
 namespace odemag {
 namespace {

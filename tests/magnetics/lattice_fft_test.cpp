@@ -1,16 +1,16 @@
-// FFT convolution of the demagnetizing tensor on lattices (magnetics/lattice_fft.h)
+// FFT convolution of the demagnetizing tensor on lattices (magnetics/static/lattice_fft.h)
 // against the dense pairwise sums of the same tensors, and the Newton-Krylov
-// B-H solve (magnetics/bh_lattice_solve.h) on a soft cube against the curve.
+// B-H solve (magnetics/static/bh_lattice_solve.h) on a soft cube against the curve.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include "magnetics/bh_lattice_solve.h"
-#include "magnetics/constants.h"
-#include "magnetics/kernels.h"
-#include "magnetics/lattice_fft.h"
-#include "magnetics/rng.h"
+#include "magnetics/static/bh_lattice_solve.h"
+#include "odemag/constants.h"
+#include "magnetics/kernels/kernels.h"
+#include "magnetics/static/lattice_fft.h"
+#include "magnetics/kernels/rng.h"
 
 namespace odemag {
 namespace {

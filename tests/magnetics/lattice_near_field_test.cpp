@@ -1,4 +1,4 @@
-// The lattice near field (magnetics/lattice_near_field.cpp): close pairs of
+// The lattice near field (magnetics/near_field/lattice_near_field.cpp): close pairs of
 // cells of touching, aligned lattice bodies couple through the cell-averaged
 // (Newell) tensor, as inside a body. So cutting a body into touching pieces
 // changes nothing (moment and force within 0.5%), touching bodies converge
@@ -13,13 +13,13 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/demag_tensor.h"
-#include "magnetics/kernels.h"
-#include "magnetics/model.h"
-#include "magnetics/near_field.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/cells/demag_tensor.h"
+#include "magnetics/kernels/kernels.h"
+#include "magnetics/model/model.h"
+#include "magnetics/near_field/near_field.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 #include "tests/support/magnetic_checks.h"
 
 namespace odemag {
@@ -40,7 +40,7 @@ SoftMaterial linear_iron() {
 double rel(const Vec3& a, const Vec3& b) { return norm(a - b) / norm(b); }
 
 // ---------------------------------------------------------------------------
-// The tensor at real offsets (magnetics/demag_tensor.h).
+// The tensor at real offsets (magnetics/cells/demag_tensor.h).
 
 TEST(CubeDemagTensorAt, EqualsLatticeTensorAndItsGradientMatchesDifferences) {
   for (int i = -3; i <= 3; ++i)
@@ -154,7 +154,7 @@ TEST(LatticeNearField, CutCubeKeepsItsMoment) {
   }
   // Without the correction (the point dipoles of the paper) the halves differ
   // by percents. (They did not converge in the default 200 iterations before
-  // the block preconditioner, magnetics/body_response.h; they converge now, to
+  // the block preconditioner, magnetics/model/body_response.h; they converge now, to
   // the wrong moment: measured 3.2e-2.)
   const CutCubeResult without = relax_cut_cube(2, 1, 1, false, false);
   std::printf("[lattice near field] cube cut 2x1x1 without the correction: moment error %.2e, converged %d\n",
@@ -185,7 +185,7 @@ TEST(LatticeNearField, CutCubeKeepsItsForceNextToAMagnet) {
 }
 
 // ---------------------------------------------------------------------------
-// Forces and torques are the energy's derivatives (magnetics/near_field.h).
+// Forces and torques are the energy's derivatives (magnetics/near_field/near_field.h).
 
 // A permanent lattice magnet (body 0) and a soft lattice body (body 1) on
 // its top face, turned by a signed permutation (90 degrees about z) and
@@ -284,7 +284,7 @@ TEST(LatticeNearField, ForcesAndTorquesAreMinusEnergyGradientNearContact) {
 // Two soft lattice spheres (chi = 1000, R = 4 h, 408 cells each) touching
 // with aligned lattices in a uniform field converge with the default options
 // (measured 48-52 outer iterations, and about as many without the correction:
-// with the partial boundary cells of magnetics/cells.h the spheres touch at a
+// with the partial boundary cells of magnetics/cells/cells.h the spheres touch at a
 // few cells only). Touching faces are the hard case: the two halves of the
 // cut cube above do not converge in 200 iterations without it, in 41 with it.
 TEST(LatticeNearField, TouchingLatticeSpheresConverge) {

@@ -1,6 +1,6 @@
-// Tests of the per-cell LLG physics (magnetics/llg.h): docs/model.md "LLG
+// Tests of the per-cell LLG physics (magnetics/kernels/llg.h): docs/model.md "LLG
 // integration" and the paper's App. B, App. C, Figs. 10 and 11.
-#include "magnetics/llg.h"
+#include "magnetics/kernels/llg.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <vector>
 
-#include "magnetics/relax.h"
+#include "magnetics/relax/relax.h"
 
 namespace odemag {
 namespace {

@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 
@@ -130,7 +130,7 @@ TEST(NonFiniteCells, OneNaNMomentFails) {
     expect_failed(relax(b.model, b.state, c.options, *backend), std::string(c.name) + ", 8-moment ball");
   }
   // An isotropic cell's local relaxation ends at its exact minimum
-  // (isotropic_minimum, magnetics/llg.h), which replaces a NaN moment when
+  // (isotropic_minimum, magnetics/kernels/llg.h), which replaces a NaN moment when
   // the applied field is finite: without mutual induction (one pass under
   // the fixed field) that heals the cell, and the result is finite and
   // converged. With mutual induction the NaN magnetization reaches every

@@ -12,13 +12,13 @@
 #include <stdexcept>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/body_response.h"
-#include "magnetics/cells.h"
-#include "magnetics/constants.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
-#include "magnetics/state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/body_response.h"
+#include "magnetics/cells/cells.h"
+#include "odemag/constants.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
 #include "tests/support/contact_references.h"
 
 namespace odemag {

@@ -6,9 +6,9 @@
 #include <functional>
 #include <vector>
 
-#include "magnetics/backend.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

@@ -12,8 +12,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "magnetics/backend.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/relax/relax.h"
 #include "tests/support/contact_references.h"
 
 namespace odemag {

@@ -1,4 +1,4 @@
-// Near field of one-cell spheres (magnetics/sphere_near_field.cpp,
+// Near field of one-cell spheres (magnetics/near_field/sphere_near_field.cpp,
 // docs/model.md "The near field"): forces between a one-cell soft ball and a
 // magnet ball, and between two one-cell soft balls in a uniform field,
 // against the exact linear solutions of tests/support/contact_references.h
@@ -9,8 +9,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "magnetics/backend.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/relax/relax.h"
 #include "tests/support/contact_references.h"
 #include "tests/support/magnetic_checks.h"
 
@@ -224,7 +224,7 @@ TEST(SphereNearField, ClosedSystemHasZeroNetForceAndTorque) {
   EXPECT_LT(norm(T), 1e-10 * scale * kR);
 }
 
-// Carried-over pairs (magnetics/sphere_near_field.cpp): a soft ball 0.1 R
+// Carried-over pairs (magnetics/near_field/sphere_near_field.cpp): a soft ball 0.1 R
 // from a magnet ball, magnetization held, moved by 0.9 of the reuse
 // tolerance (1e-2 of the gap) keeps its pair's last evaluation carried to
 // second order: force within 2e-5 and torque within 2e-8 of a fresh
@@ -279,7 +279,7 @@ TEST(SphereNearField, PairsCarriedOverWithinTheToleranceMatchAFreshEvaluation) {
   EXPECT_EQ(T.x, T_ref.x);
 }
 
-// The pair list (magnetics/sphere_near_field.cpp): pairs within (4 + 0.2)
+// The pair list (magnetics/near_field/sphere_near_field.cpp): pairs within (4 + 0.2)
 // (R_a + R_b), made anew once a sphere has moved 0.2 R_min. A soft ball
 // starts beyond it (4.5 (R_a + R_b) from a magnet ball: no correction) and
 // comes in along a line in steps of 0.13 R, wobbling across it,

@@ -1,8 +1,8 @@
 // TEAM workshop problem 20 (tests/support/team20.h, docs/validation.md
 // "TEAM 20"): the steel pole in the steel yoke inside the coil, solved on the
-// FFT lattices (magnetics/lattice_fft.h; every cell all steel: cubes of h =
+// FFT lattices (magnetics/static/lattice_fft.h; every cell all steel: cubes of h =
 // 5 mm and layers of thinner cells at the pole's top and the bar's ends, 2375
-// cells) with the Newton-GMRES B-H solve (magnetics/bh_lattice_solve.h),
+// cells) with the Newton-GMRES B-H solve (magnetics/static/bh_lattice_solve.h),
 // against the measured force and gap flux density (COMPEL 14(2/3), 1995, the
 // references in team20.h).
 //
@@ -60,7 +60,7 @@ TEST(Team20, ForceOnThePoleAgainstTheMeasuredValues) {
 }
 
 // The quarter model with the mirror planes x = 0 and y = 0 (team20::
-// GradedProblem, magnetics/cuboid_demag.h), uniform cells of about 5 mm
+// GradedProblem, magnetics/static/cuboid_demag.h), uniform cells of about 5 mm
 // (grading 5/1/5: 720 unknown cells for 2880 in all): at 3000 AT the force
 // within 5% of the measured value (+1.5%), along z by construction, and the
 // magnetic forces balance; the faces graded toward the refined faces.

@@ -1,4 +1,4 @@
-// The predicted warm start of the two-level relaxation (magnetics/relax.cpp,
+// The predicted warm start of the two-level relaxation (magnetics/relax/relax.cpp,
 // docs/model.md "Predicted warm start"): a relaxation starts from its first
 // iterate plus the change of the applied field the last relaxation found,
 // where the last two relaxations changed it alike (a steady drift). It may
@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <memory>
 
-#include "magnetics/backend.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

@@ -4,7 +4,7 @@
 // there (an iterate that shrinks every field by one factor keeps its
 // relative residual). The scale is floored at a millionth of the largest
 // field scale the state has converged at (MagneticState::peak_field_scale,
-// magnetics/relax.cpp): such relaxations end in a few iterations, with the
+// magnetics/relax/relax.cpp): such relaxations end in a few iterations, with the
 // fields resolved to tolerance x that floor.
 #include <gtest/gtest.h>
 
@@ -12,9 +12,9 @@
 #include <cstdio>
 #include <memory>
 
-#include "magnetics/backend.h"
-#include "magnetics/model.h"
-#include "magnetics/relax.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
 
 using namespace odemag;
 

@@ -2,7 +2,7 @@
 // near a point dipole and near each other, coaxial cylinder magnets, and the
 // magnetometric demagnetizing factor of a soft cube. Written from the physics
 // only: nothing here uses odemag's engine code; only the plain value type Vec3
-// (magnetics/vec3.h) and the constants kPi, kMu0 (magnetics/constants.h) are
+// (include/odemag/vec3.h) and the constants kPi, kMu0 (include/odemag/constants.h) are
 // shared. SI units throughout (H, M in A/m, moments in A m^2, forces in N,
 // energies in J). Magnetic scalar potential phi with H = -grad phi; the
 // potential of a magnetic charge density rho (A/m^2 per m) is
@@ -231,8 +231,8 @@
 
 #include <Eigen/Dense>
 
-#include "magnetics/constants.h"
-#include "magnetics/vec3.h"
+#include "odemag/constants.h"
+#include "odemag/vec3.h"
 
 namespace odemag::reference {
 

@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "magnetics/model.h"
-#include "magnetics/state.h"
+#include "magnetics/model/model.h"
+#include "magnetics/model/state.h"
 #include "tests/support/test_math.h"
 
 namespace odemag::test_support {
@@ -86,7 +86,7 @@ inline MagneticModel soft_body_model(IntraBodyTensor kind, const Shape& shape, d
 // a soft body: above 1 the body magnetizes itself without any applied field.
 // H_i = sum_j F_ij V_j M_j with F symmetric: the lattice tensors, and for
 // bodies with boundary cells the boundary correction (self and uniform-mode
-// tensors, magnetics/model.cpp). The map is similar to W^1/2 F W^1/2 / gamma_D
+// tensors, magnetics/model/model.cpp). The map is similar to W^1/2 F W^1/2 / gamma_D
 // (W = diag V), which is symmetric.
 inline double largest_response_eigenvalue(const MagneticBody& b) {
   const int n = b.cell_count();

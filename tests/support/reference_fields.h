@@ -1,7 +1,7 @@
 // Independent analytic references for the magnetics tests: fields of uniformly
 // magnetized cuboids and spheres, and the magnetization of linear (soft or
 // recoil) spheres in a uniform field. Written from the physics only: nothing
-// here uses odemag's kernels (magnetics/kernels.h) or its relaxation code;
+// here uses odemag's kernels (magnetics/kernels/kernels.h) or its relaxation code;
 // only the plain Vec3 / Mat3 value types are shared. SI units throughout
 // (H, M in A/m, B in T, moments in A m^2).
 //
@@ -74,7 +74,7 @@
 #include <cmath>
 #include <vector>
 
-#include "magnetics/vec3.h"
+#include "odemag/vec3.h"
 
 namespace odemag::reference {
 

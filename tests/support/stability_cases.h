@@ -19,11 +19,11 @@
 #include <variant>
 #include <vector>
 
-#include "engine/sim/simulation.h"
-#include "magnetics/constants.h"
-#include "magnetics/kernels.h"
-#include "magnetics/near_field.h"
-#include "magnetics/relax.h"
+#include "engine/simulation/simulation.h"
+#include "odemag/constants.h"
+#include "magnetics/kernels/kernels.h"
+#include "magnetics/near_field/near_field.h"
+#include "magnetics/relax/relax.h"
 #include "tests/support/scene_builders.h"
 
 namespace odemag::stability {
@@ -220,7 +220,7 @@ inline double available_energy(const CaseResult& r, bool started_overlapping) {
 inline constexpr int kPenetrationBodies = 64;
 
 // How much larger than its shape a body's collision geometry is (the
-// collision skin of engine/sim/rigid_world.cpp), read back from ODE.
+// collision skin of engine/simulation/rigid_world.cpp), read back from ODE.
 inline double collision_skin(dGeomID g, const Shape& shape) {
   if (const auto* s = std::get_if<Sphere>(&shape)) return dGeomSphereGetRadius(g) - s->radius;
   if (const auto* b = std::get_if<Box>(&shape)) {

@@ -36,13 +36,13 @@
 #include <cmath>
 #include <vector>
 
-#include "magnetics/bh_curve.h"
-#include "magnetics/bh_lattice_solve.h"
-#include "magnetics/cell_field.h"
-#include "magnetics/coil.h"
-#include "magnetics/cuboid_demag.h"
-#include "magnetics/constants.h"
-#include "magnetics/lattice_fft.h"
+#include "magnetics/materials/bh_curve.h"
+#include "magnetics/static/bh_lattice_solve.h"
+#include "magnetics/kernels/cell_field.h"
+#include "magnetics/sources/coil.h"
+#include "magnetics/static/cuboid_demag.h"
+#include "odemag/constants.h"
+#include "magnetics/static/lattice_fft.h"
 
 namespace odemag::team20 {
 
@@ -243,7 +243,7 @@ inline Result solve(const Problem& p, double ampere_turns, std::vector<Vec3>& M,
 // on the bar, its y = 5 on the bar, the columns and the top bars, the
 // columns' x = 38.5 on the bar and the top bars)
 // and grow by `growth` per cell away from them up to h_max; the symmetry
-// planes are not refined. The dense sum of magnetics/cuboid_demag.h, with
+// planes are not refined. The dense sum of magnetics/static/cuboid_demag.h, with
 // the images in both planes.
 struct Grading {
   double h_min, growth, h_max;  // mm
@@ -287,7 +287,7 @@ struct GradedProblem {
   bool balance = false;
   int pole_cells = 0;  // the pole's cells come first
   CuboidDemag demag;
-  CuboidDemag::ForceOperator force_from_yoke, force_on_yoke;  // (2) of magnetics/cuboid_demag.h
+  CuboidDemag::ForceOperator force_from_yoke, force_on_yoke;  // (2) of magnetics/static/cuboid_demag.h
   std::vector<Vec3> coil_H;                        // at 1 A-turn, at the cell centres
   std::vector<std::array<Vec3, 3>> coil_gradient;  // pole cells: d(coil_H)/dx_a, 1 A-turn
   BhCurve curve{bh_table()};
@@ -321,7 +321,7 @@ struct GradedProblem {
   }
 
   // balance: also the forces on the yoke from the pole (the momentum check).
-  // The operator dense, or as a hierarchical matrix (magnetics/hmatrix.h)
+  // The operator dense, or as a hierarchical matrix (magnetics/static/hmatrix.h)
   // in double or single precision.
   enum class Storage { dense, compressed, compressed_single };
   explicit GradedProblem(const Grading& g, bool with_balance = false, Storage storage = Storage::compressed)

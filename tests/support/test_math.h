@@ -4,8 +4,8 @@
 #include <Eigen/Dense>
 #include <cmath>
 
-#include "magnetics/eigen_tensors.h"
-#include "magnetics/vec3.h"
+#include "magnetics/kernels/eigen_tensors.h"
+#include "odemag/vec3.h"
 
 namespace odemag::test_support {
 
@@ -16,7 +16,7 @@ inline Mat3 axis_rotation(const Vec3& axis, double angle) {
   return rotation_from_quaternion(std::cos(angle / 2), s * a.x, s * a.y, s * a.z);
 }
 
-// Tensors as Eigen matrices: the library's (magnetics/eigen_tensors.h).
+// Tensors as Eigen matrices: the library's (magnetics/kernels/eigen_tensors.h).
 using odemag::eigen_matrix;
 using odemag::symmetric_matrix;
 

@@ -1,4 +1,4 @@
-// A rounded-rectangle coil's copper by its definition (magnetics/coil.h),
+// A rounded-rectangle coil's copper by its definition (magnetics/sources/coil.h),
 // for tests that check what comes near it: the points at distance
 // inner_corner_radius..outer_corner_radius from the core rectangle, |w| <=
 // height / 2, in the coil's frame (u, v, w off its centre).
@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "magnetics/coil.h"
+#include "magnetics/sources/coil.h"
 
 namespace odemag::test_support {
 

@@ -1,0 +1,191 @@
+// Magnetics for ODE bodies: the force accumulator that the scene simulation
+// registers, and the public API for embedding odemag in an ODE program
+// (docs/embedding.md):
+//
+//   odemag::MagneticForces magnetics;
+//   magnetics.attach(magnet_body, odemag::Box{{0.1, 0.02, 0.02}},
+//                    odemag::PermanentMaterial{{1e6, 0, 0}}, 0.005);
+//   magnetics.attach(ball_body, odemag::Sphere{0.006}, iron);
+//   loop { magnetics.apply(); dSpaceCollide(...); dWorldQuickStep(...); dJointGroupEmpty(...); }
+//
+// or that loop in the substeps of `odemag run`: MagneticStepper
+// (engine/embedding/magnetic_stepper.h, docs/embedding.md "Substeps").
+//
+// The moments persist from step to step (warm start), which is what makes
+// remanence possible.
+#pragma once
+
+#include <ode/ode.h>
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/embedding/force_accumulator.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/model.h"
+#include "magnetics/relax/relax.h"
+#include "magnetics/model/state.h"
+
+namespace odemag {
+
+// A copy of the magnetic state (MagneticForces::save_state), and what it
+// belongs to: the cell and moment counts of every body it was saved from.
+struct SavedMagneticState {
+  MagneticState state;
+  RelaxReport report;                // last_report() when saved
+  std::vector<int> body_cells;       // per body: cells
+  std::vector<int> body_moments;     // per body: soft moments
+  std::vector<int> body_refinements;  // per body: refine_body calls before the save
+};
+
+class MagneticForces : public ForceAccumulator {
+ public:
+  // backend: nullptr for the CPU backend with all cores.
+  explicit MagneticForces(const RelaxOptions& options = {},
+                          std::unique_ptr<MagneticBackend> backend = nullptr, uint64_t seed = 1,
+                          IntraBodyTensor intra_tensor = IntraBodyTensor::cell_average);
+
+  // Magnetics built elsewhere (a scene's, engine/simulation/magnetic_system.h): the
+  // model and its state as they are; bind() then ties bodies to ODE bodies.
+  MagneticForces(MagneticModel model, MagneticState state, const RelaxOptions& options,
+                 std::unique_ptr<MagneticBackend> backend);
+  // Ties magnetic body index to an ODE body (nullptr: static, set_pose) and
+  // takes its pose. Throws std::out_of_range on a bad index.
+  void bind(int index, dBodyID body);
+
+  // Attaches a shape (centred on the body's centre of mass, in its frame) and
+  // a material to an ODE body and returns the magnetic body index. body may be
+  // nullptr for a static body placed with set_pose. cell_size <= 0: one cell.
+  // Throws std::invalid_argument on a bad shape or material, or a lattice of
+  // more than kMaxBodyLatticePoints points (magnetics/model/model.h), before any
+  // cell is made.
+  int attach(dBodyID body, const Shape& shape, const Material& material, double cell_size = 0.0,
+             const std::string& name = "");
+  // The same with the material named `material` of a set of named materials,
+  // a scene file's (SceneDescription::materials, engine/scene/scene.h;
+  // docs/embedding.md "Materials from a scene file"). Throws
+  // std::invalid_argument naming the material and the known ones when there
+  // is none of that name.
+  int attach(dBodyID body, const Shape& shape, const std::map<std::string, Material>& materials,
+             const std::string& material, double cell_size = 0.0, const std::string& name = "");
+
+  // Reads the poses of the ODE bodies, relaxes the magnetization from the
+  // previous step's moments, computes forces and torques and adds them to the
+  // (non-kinematic, enabled or woken) ODE bodies. Returns the relaxation report.
+  const RelaxReport& apply();
+
+  // ForceAccumulator: update() relaxes and computes, add_forces() adds.
+  // compute() and recompute_forces() throw std::domain_error, naming the
+  // body (name and index), when an active body's pose (its ODE body's, or
+  // the one set_pose or state() gave it), its magnetization scale or the
+  // external field is not finite; they check before relaxing, the state
+  // keeps the last step's forces.
+  void update(double, double) override { compute(); }
+  // Adds the forces and torques to the active, magnetic, non-kinematic ODE
+  // bodies that are enabled. A body ODE put to sleep (disabled, its
+  // auto-disable flag set) is woken (dBodyEnable) when its magnetic force
+  // or torque has changed, since the last add_forces() that found it awake
+  // (or the first that found it asleep, for a body never seen awake), by
+  // more than wake_tolerance() times the load that holds it at rest:
+  //   |F - F_0| > tol (|F_0| + m |g|)  or  |T - T_0| > tol (|T_0| + r (|F_0| + m |g|)),
+  // m its ODE mass, g the world's gravity, r half the diagonal of the
+  // shape's bounding box. A body resting in a steady field stays asleep; one a magnet
+  // approaches is woken. Bodies whose auto-disable flag is off (disabled by
+  // the program, as the scene simulation removes bodies) are never woken.
+  void add_forces() override;
+  // The same for one body, if it is one of the model's (ForceAccumulator).
+  void add_forces_to(dBodyID body) override;
+  const RelaxReport& compute();
+  // Forces and torques at the bodies' current poses with the magnetization of
+  // the last compute() held (magnetic_forces_at_held_magnetization): no
+  // relaxation. add_forces() then adds them.
+  void recompute_forces();
+
+  // Throws std::invalid_argument when H is not finite.
+  void set_external_field(const Vec3& H);
+  Vec3 external_field() const { return state_.external_field; }
+  // Relative change of force or torque that wakes a sleeping body
+  // (add_forces); default 1e-3, infinity never wakes. Throws
+  // std::invalid_argument when negative or NaN.
+  void set_wake_tolerance(double tolerance);
+  double wake_tolerance() const { return wake_tolerance_; }
+  // Every call taking a body index throws std::out_of_range naming the call
+  // and the index when it is not 0 .. body_count() - 1.
+  // A body that is not active neither makes nor feels a field (removed).
+  void set_active(int index, bool active) { state_.active[body_index(index, "set_active")] = active ? 1 : 0; }
+  bool active(int index) const { return state_.active[body_index(index, "active")] != 0; }
+  // Scales a permanent magnet's remanent magnetization (electromagnets, the
+  // crane). Throws std::invalid_argument when scale is not finite.
+  void set_magnetization_scale(int index, double scale);
+  double magnetization_scale(int index) const {
+    return state_.magnetization_scale[body_index(index, "magnetization_scale")];
+  }
+  // Pose of a static (body == nullptr) magnetic body. Throws
+  // std::invalid_argument when it is not finite.
+  void set_pose(int index, const BodyPose& pose);
+
+  RelaxOptions& options() { return options_; }
+  const RelaxOptions& options() const { return options_; }
+  const RelaxReport& last_report() const { return report_; }
+
+  int body_count() const { return model_.body_count(); }
+  dBodyID ode_body(int index) const { return bodies_[body_index(index, "ode_body")]; }
+  // A m^2, world; zero for a body that is not active.
+  Vec3 moment(int index) const;
+  Vec3 force(int index) const { return state_.force[body_index(index, "force")]; }                  // N, world
+  Vec3 torque(int index) const { return state_.torque[body_index(index, "torque")]; }                // N m, about the CoM
+
+  // Gives a body new refined contact zones (MagneticModel::refine_body,
+  // docs/model.md "Refined contact zones"; none: its plain cells again): its
+  // cells are built anew and take the magnetization the old cells held there
+  // (transfer_refined_state); the next compute() relaxes. A state saved
+  // before no longer restores (restore_state refuses it). Throws std::out_of_range on a bad index
+  // and std::invalid_argument, changing nothing, for zones add_body refuses.
+  void refine_body(int index, const std::vector<RefinedZone>& zones);
+
+  // Saving and restoring the magnetic state (docs/embedding.md "Saving and
+  // restoring"): every cell's moments and magnetization, the warm-start and
+  // skip data, poses, forces, active flags, magnetization scales, the
+  // external field, the noise counters and the last relaxation report.
+  // restore_state() throws std::invalid_argument, changing nothing, when the
+  // state was saved from magnetics with other bodies or cells.
+  SavedMagneticState save_state() const;
+  void restore_state(const SavedMagneticState& saved);
+
+  const MagneticModel& model() const { return model_; }
+  const MagneticState& state() const { return state_; }
+  MagneticState& state() { return state_; }
+  MagneticBackend& backend() { return *backend_; }
+
+ private:
+  // index, or std::out_of_range naming the call when it is not a body index.
+  int body_index(int index, const char* call) const;
+  void read_poses();
+  // std::domain_error, naming call and body, on a non-finite input of a step.
+  void check_inputs(const char* call) const;
+  // add_forces: whether sleeping body b is to be woken.
+  bool wakes(int b) const;
+  // add_forces: the body's force and torque become its F_0, T_0.
+  void note_reference(int b);
+  void add_forces_of(int b);  // add_forces() for body b
+
+  MagneticModel model_;
+  MagneticState state_;
+  std::vector<dBodyID> bodies_;
+  std::unique_ptr<MagneticBackend> backend_;
+  RelaxOptions options_;
+  RelaxReport report_;
+  double wake_tolerance_ = 1e-3;
+  // Per body: F_0, T_0 of the wake-up rule (add_forces), and whether set.
+  std::vector<Vec3> reference_force_, reference_torque_;
+  std::vector<uint8_t> reference_known_;
+  std::vector<int> refinements_;  // per body: refine_body calls (save_state, restore_state)
+};
+
+// Pose of an ODE body as a magnetics BodyPose.
+BodyPose ode_pose(dBodyID body);
+
+}  // namespace odemag

@@ -1,0 +1,175 @@
+#include "engine/simulation/magnetic_system.h"
+
+#include <stdexcept>
+
+#include "engine/simulation/simulation.h"
+#include "gpu/cuda_backend.h"
+#include "magnetics/cells/cells.h"
+
+namespace odemag {
+
+BodyPose scene_pose(const BodyDescription& body) {
+  BodyPose pose;
+  pose.position = body.position;
+  pose.rotation = rotation_from_quaternion(body.orientation.w, body.orientation.x,
+                                           body.orientation.y, body.orientation.z);
+  return pose;
+}
+
+bool takes_contact_zones(const SceneDescription& scene, int b) {
+  const BodyDescription& body = scene.bodies[b];
+  const auto material = scene.materials.find(body.material);
+  return std::holds_alternative<Sphere>(body.shape) && material != scene.materials.end() &&
+         has_positive_susceptibility(material->second) &&
+         uses_volume_shares(body.shape, scene.body_cell_size(b));
+}
+
+std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vector<BodyPose>& poses,
+                                 const std::vector<uint8_t>& active, int b) {
+  if (!takes_contact_zones(scene, b)) return {};
+  const BodyDescription& body = scene.bodies[b];
+  const auto* ball = std::get_if<Sphere>(&body.shape);
+  const BodyPose& pose = poses[b];
+  std::vector<Vec3> points;
+  for (size_t o = 0; o < scene.bodies.size(); ++o) {
+    const BodyDescription& other = scene.bodies[o];
+    const auto other_material = scene.materials.find(other.material);
+    if (static_cast<int>(o) == b || other_material == scene.materials.end() ||
+        is_inert(other_material->second) || (!active.empty() && !active[o]))
+      continue;
+    // The other body's point nearest this ball's centre, and this ball's
+    // surface point towards it.
+    const BodyPose& other_pose = poses[o];
+    const Vec3 nearest =
+        other_pose.position +
+        other_pose.rotation * closest_point_in_shape(other.shape, other_pose.rotation.transpose_times(
+                                                                      pose.position - other_pose.position));
+    const Vec3 towards = nearest - pose.position;
+    const double distance = norm(towards);
+    if (!(distance > 0.0) || distance - ball->radius > kContactRefinementGap * ball->radius) continue;
+    points.push_back(pose.rotation.transpose_times((ball->radius / distance) * towards));
+  }
+  return points;
+}
+
+std::vector<RefinedZone> contact_zones(const SceneDescription& scene,
+                                       const std::vector<BodyPose>& poses,
+                                       const std::vector<uint8_t>& active, int b) {
+  const double h = scene.body_cell_size(b);
+  std::vector<RefinedZone> zones;
+  for (const Vec3& point : contact_points(scene, poses, active, b))
+    zones.push_back({point, default_refinement_radii(h)});
+  return zones;
+}
+
+std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene) {
+  std::vector<std::vector<RefinedZone>> zones(scene.bodies.size());
+  if (!scene.solver.contact_refinement) return zones;
+  std::vector<BodyPose> poses;
+  for (const BodyDescription& body : scene.bodies) poses.push_back(scene_pose(body));
+  for (size_t b = 0; b < scene.bodies.size(); ++b)
+    zones[b] = contact_zones(scene, poses, {}, static_cast<int>(b));
+  return zones;
+}
+
+MagneticSystem build_magnetic_system(const SceneDescription& scene) {
+  MagneticSystem ms;
+  ms.contact_zones = scene_contact_zones(scene);
+  ms.model.set_graded_cells(scene.solver.graded_cells);
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    const BodyDescription& body = scene.bodies[b];
+    const auto material = scene.materials.find(body.material);
+    if (material == scene.materials.end())
+      throw SceneError(scene.file, "bodies[" + std::to_string(b) + "].material",
+                       "unknown material \"" + body.material + "\"");
+    try {
+      const int index = ms.model.add_body(body.name, body.shape, material->second,
+                                          scene.body_cell_size(static_cast<int>(b)),
+                                          ms.contact_zones[b]);
+      for (const CoilSource& coil : body.coils) ms.model.add_coil(index, coil);
+    } catch (const std::invalid_argument& e) {
+      throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
+    }
+  }
+  ms.state = make_state(ms.model, scene.seed);
+  ms.state.external_field = scene.external_field;
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    ms.state.pose[b] = scene_pose(scene.bodies[b]);
+    ms.state.active[b] = scene.bodies[b].present ? 1 : 0;
+  }
+  place_cells(ms.model, ms.state);
+  return ms;
+}
+
+void apply_events_at_start(const SceneDescription& scene, MagneticSystem& system, RelaxOptions& options) {
+  for (const TimelineEvent& e : scene.timeline) {
+    const int body = e.body.empty() ? -1 : scene.find_body(e.body);
+    if (e.kind == TimelineEvent::Kind::keyframes) {
+      system.state.pose[body] = keyframe_pose(e.keys, 0.0);
+      continue;
+    }
+    if (e.time != 0.0 || e.end_time != 0.0) continue;  // later, or a ramp (at its start value at t = 0)
+    switch (e.kind) {
+      case TimelineEvent::Kind::add_body: system.state.active[body] = 1; break;
+      case TimelineEvent::Kind::remove_body: system.state.active[body] = 0; break;
+      case TimelineEvent::Kind::scale_magnetization: system.state.magnetization_scale[body] = e.value; break;
+      case TimelineEvent::Kind::mutual_induction: options.mutual_induction = e.enabled; break;
+      case TimelineEvent::Kind::external_field: system.state.external_field = e.field; break;
+      case TimelineEvent::Kind::keyframes: break;
+    }
+  }
+  place_cells(system.model, system.state);
+}
+
+SceneCellCounts count_scene_cells(const SceneDescription& scene) {
+  SceneCellCounts counts;
+  const std::vector<std::vector<RefinedZone>> scene_zones = scene_contact_zones(scene);
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    const BodyDescription& body = scene.bodies[b];
+    const Material& material = scene.materials.at(body.material);
+    if (is_inert(material)) continue;
+    const double h = scene.body_cell_size(static_cast<int>(b));
+    const std::vector<RefinedZone>& zones = scene_zones[b];
+    double cells = 1.0;
+    try {
+      if (h > 0.0)
+        cells = static_cast<double>(
+            (zones.empty() ? make_cells(body.shape, h) : make_refined_cells(body.shape, h, zones)).size());
+    } catch (const std::invalid_argument& e) {  // refined zones beyond kMaxRefinedCells
+      throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
+    }
+    counts.magnetized += cells;
+    if (has_positive_susceptibility(material)) counts.responsive += cells;
+  }
+  return counts;
+}
+
+std::string cpu_only_feature(const SceneDescription& scene) {
+  if (scene.solver.graded_cells) return "graded cells (solver.graded_cells)";
+  // A lattice ball that may get zones, now or when a run moves them.
+  for (size_t b = 0; scene.solver.contact_refinement && b < scene.bodies.size(); ++b)
+    if (takes_contact_zones(scene, static_cast<int>(b)))
+      return "refined contact zones (solver.contact_refinement)";
+  for (const auto& [name, material] : scene.materials)
+    if (const auto* soft = std::get_if<SoftMaterial>(&material); soft && !soft->bh_curve.empty())
+      return "a B-H curve (materials." + name + ".bh_curve)";
+  return "";
+}
+
+std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threads,
+                                              std::string* notice, const std::string& cpu_only) {
+  if (name == "cpu") return make_cpu_backend(threads);
+  if (!cpu_only.empty() && name == "cuda")
+    throw std::invalid_argument("backend \"cuda\" does not support " + cpu_only);
+  if (!cpu_only.empty() && name == "auto") return make_cpu_backend(threads);
+  if (name == "cuda" || name == "auto") {
+    std::string why;
+    if (auto gpu = make_cuda_backend(&why)) return gpu;
+    if (name == "cuda") throw std::invalid_argument("backend \"cuda\" is not available: " + why);
+    if (notice) *notice = "odemag: no CUDA device (" + why + "); using the CPU backend";
+    return make_cpu_backend(threads);
+  }
+  throw std::invalid_argument("unknown backend \"" + name + "\" (cpu, cuda or auto)");
+}
+
+}  // namespace odemag
