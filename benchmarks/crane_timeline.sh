@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The crane step by step, an earlier build against the current one, one after
-# the other on the same machine (docs/benchmarks.md section 4):
+# the other on the same machine (docs/benchmarks.md):
 #
 #   benchmarks/crane_timeline.sh --before PATH [--after PATH] [--duration T] [--out DIR]
 #                                [--before-scene FILE] [--after-scene FILE]

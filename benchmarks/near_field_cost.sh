@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # What the near-field corrections cost (docs/benchmarks.md): each scene run
-# with solver.near_field false (old: point dipoles) and true (new), one after
-# the other on the same machine and build, full durations, frames off; T_m
-# per rigid step (median, mean) and the ratio new / old.
+# with solver.near_field false (point dipoles, labelled "old" in the tables)
+# and true (the default, labelled "new"), one after the other on the same
+# machine and build, full durations, frames off; T_m per rigid step (median,
+# mean) and the ratio new / old.
 #
 #   benchmarks/near_field_cost.sh [--odemag PATH] [--threads N] [--scenes "ball_chain crane"]
 #                                 [--duration S] [--out DIR]

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """What a Python step() costs over the C++ step, on demos/scenes/crane_small.json
-(issue 18: at most 5% more). One process, one scene, the same steps:
+(the target: at most 5% more). One process, one scene, the same steps:
 
 1. sim.step() called from Python N times: the wall time of each call
    (time.perf_counter) against the wall time of the same step measured inside

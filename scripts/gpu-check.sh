@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The CUDA backend on a real device in one call (issue 15; docs/testing.md
+# The CUDA backend on a real device in one call (docs/testing.md
 # "GPU checks"). Two halves:
 #
 #   scripts/gpu-check.sh --prepare [--carry DIR] [--build DIR] [--jobs N]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Two sweeps and their plot (issue 18 item 3; docs/sweeps.md "Example").
+"""Two sweeps and their plot (docs/sweeps.md "Example").
 
 1. Balls held by the crane magnet against its coil field (the core's
    magnetization): demos/scenes/crane_small.json (120 balls) cut to 3.0 s,

@@ -131,10 +131,10 @@ scene = {
     "bodies": bodies,
     "solver": {"tolerance": 1e-4},
     # Later substeps relax only around the balls that need them (docs/simulation.md
-    # "Substeps"; the same balls held over seeds, docs/benchmarks.md section 4l).
+    # "Substeps"; the same balls held over seeds, benchmarks/results/crane_moving.md).
     # 30 QuickStep sweeps (the default): over seeds 1-5 the same balls held as
     # with 40, within 4% of the substeps, T_r -24%; 20 takes 7% more substeps
-    # (docs/benchmarks.md section 4o).
+    # (benchmarks/results/crane_solver_iterations.md).
     "simulation": {"time_step": 0.001, "duration": 5.0, "frame_rate": 30, "contact_solver": "quick",
                    "solver_iterations": 30, "magnetic_solve": "moving"},
     "timeline": [
@@ -151,7 +151,7 @@ scene = {
 }
 # No spinning resistance about the contact normals: one row fewer per contact
 # in ODE's quick step, T_r -21% on the crane over six seeds, the same balls held
-# (docs/benchmarks.md section 4r); crane_electromagnet_small over three seeds:
+# (benchmarks/results/crane_spinning.md); crane_electromagnet_small over three seeds:
 # T_r -15%, the same substeps and counts within their spread (docs/scenes.md).
 scene["simulation"]["contact"] = {"spinning_friction": 0}
 json.dump(scene, open(args.out, "w"), indent=1)
