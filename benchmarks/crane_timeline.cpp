@@ -4,17 +4,14 @@
 // cells at that moment (MagneticBackend::responsive_field: the dipole sums
 // over every cell pair, the intra-body tables, the near-field and boundary
 // terms), so that T_m can be stated in field evaluations, a measure that does
-// not depend on the machine (docs/benchmarks.md section 4).
+// not depend on the machine (docs/benchmarks.md "Where the crane's time goes").
 //
 //   crane_timeline [--scene PATH] [--duration T] [--threads N] [--probe-every N]
-//                  [--bin-steps N] [--sleep-time T] --csv FILE [--label TEXT]
+//                  [--bin-steps N] --csv FILE [--label TEXT]
 //
-// --sleep-time T replaces the scene's simulation.sleep.time (0: no sleeping
-// bodies), so that one build compares the two.
 // Writes FILE: one row per bin of --bin-steps steps (default 10): the bin's
 // start time, its steps' mean and largest T_m and T_r (ms), mean iterations
-// and substeps, the latest dense-evaluation time (ms) and the mean count of
-// sleeping bodies. Prints the scene's
+// and substeps and the latest dense-evaluation time (ms). Prints the scene's
 // outcomes and, per phase of the crane's time line (descent 0-0.8 s, grip
 // 0.8-1.3, lift 1.3-2.3, hold 2.3-3.0, reduced 3.0-4.0, off 4.0-5.0), a
 // markdown row: mean T_m, T_r and T_m + T_r, largest T_m + T_r, mean
@@ -67,7 +64,6 @@ int main(int argc, char** argv) {
   bench::restart_with_passive_omp(argv);
   std::string scene_path = std::string(ODEMAG_SOURCE_DIR) + "/demos/scenes/crane.json", csv, label = "odemag";
   double duration = -1.0;
-  double sleep_time = -1.0;  // < 0: the scene's
   int threads = 2, probe_every = 50, bin_steps = 10;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -78,7 +74,6 @@ int main(int argc, char** argv) {
     else if (a == "--bin-steps") bin_steps = std::stoi(bench::option_value(argc, argv, i, "crane_timeline"));
     else if (a == "--csv") csv = bench::option_value(argc, argv, i, "crane_timeline");
     else if (a == "--label") label = bench::option_value(argc, argv, i, "crane_timeline");
-    else if (a == "--sleep-time") sleep_time = std::stod(bench::option_value(argc, argv, i, "crane_timeline"));
     else {
       std::fprintf(stderr, "crane_timeline: unknown argument '%s'\n", a.c_str());
       return 2;
@@ -91,7 +86,6 @@ int main(int argc, char** argv) {
   SceneDescription scene = load_scene(scene_path);
   scene.solver.threads = threads;
   if (duration > 0.0) scene.simulation.duration = duration;
-  if (sleep_time >= 0.0) scene.simulation.sleep.time = sleep_time;
   Simulation sim(scene);
   sim.magnetics().compute();  // as `odemag run` does before its first frame
   std::vector<Probe> probes;
@@ -102,7 +96,7 @@ int main(int argc, char** argv) {
   }
   sim.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  const std::vector<StepRecord>& records = sim.records();
+  const std::vector<StepReport>& records = sim.records();
 
   // Latest probe at or before time t (the first one before any).
   auto probe_at = [&](double t) {
@@ -116,19 +110,18 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "crane_timeline: cannot write %s\n", csv.c_str());
     return 1;
   }
-  std::fprintf(out, "label,time_s,steps,T_m_mean_ms,T_m_max_ms,T_r_mean_ms,T_r_max_ms,iterations_mean,substeps_mean,dense_evaluation_ms,sleeping_mean\n");
+  std::fprintf(out, "label,time_s,steps,T_m_mean_ms,T_m_max_ms,T_r_mean_ms,T_r_max_ms,iterations_mean,substeps_mean,dense_evaluation_ms\n");
   for (size_t b = 0; b < records.size(); b += bin_steps) {
     const size_t e = std::min(records.size(), b + bin_steps);
-    double tm = 0, tmx = 0, tr = 0, trx = 0, it = 0, sub = 0, asleep = 0;
+    double tm = 0, tmx = 0, tr = 0, trx = 0, it = 0, sub = 0;
     for (size_t k = b; k < e; ++k) {
-      asleep += records[k].sleeping;
       tm += records[k].magnetic_ms, tmx = std::max(tmx, records[k].magnetic_ms);
       tr += records[k].rigid_ms, trx = std::max(trx, records[k].rigid_ms);
       it += records[k].iterations, sub += records[k].substeps;
     }
     const double n = static_cast<double>(e - b);
-    std::fprintf(out, "%s,%.4f,%zu,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g\n", label.c_str(), records[b].time, e - b,
-                 tm / n, tmx, tr / n, trx, it / n, sub / n, probe_at(records[b].time), asleep / n);
+    std::fprintf(out, "%s,%.4f,%zu,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g,%.4g\n", label.c_str(), records[b].time, e - b,
+                 tm / n, tmx, tr / n, trx, it / n, sub / n, probe_at(records[b].time));
   }
   std::fclose(out);
 
@@ -146,22 +139,22 @@ int main(int argc, char** argv) {
   std::printf("%s: %s, %zu steps in %.1f s wall, positions hash %016llx", label.c_str(), scene_path.c_str(),
               records.size(), wall, static_cast<unsigned long long>(hash));
   for (const auto& [name, value] : sim.outcomes()) std::printf(", %s %g", name.c_str(), value);
-  std::printf("\n| phase | steps | T_m mean | T_r mean | T_m + T_r mean | T_m + T_r max | iterations mean | substeps mean | dense evaluation | T_m / evaluation | sleeping mean |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("\n| phase | steps | T_m mean | T_r mean | T_m + T_r mean | T_m + T_r max | iterations mean | substeps mean | dense evaluation | T_m / evaluation |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   auto row = [&](const char* name, double t0, double t1) {
-    double tm = 0, tr = 0, mx = 0, it = 0, sub = 0, ev = 0, asleep = 0;
+    double tm = 0, tr = 0, mx = 0, it = 0, sub = 0, ev = 0;
     int n = 0, m = 0;
-    for (const StepRecord& r : records) {
+    for (const StepReport& r : records) {
       if (r.time < t0 - 1e-9 || r.time >= t1 - 1e-9) continue;
       tm += r.magnetic_ms, tr += r.rigid_ms, mx = std::max(mx, r.magnetic_ms + r.rigid_ms);
-      it += r.iterations, sub += r.substeps, asleep += r.sleeping, ++n;
+      it += r.iterations, sub += r.substeps, ++n;
     }
     for (const Probe& p : probes)
       if (p.time > t0 + 1e-9 && p.time <= t1 + 1e-9) ev += p.ms, ++m;
     if (n == 0) return;
     ev = m > 0 ? ev / m : probe_at(t0);
-    std::printf("| %s | %d | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g |\n", name, n, tm / n,
-                tr / n, (tm + tr) / n, mx, it / n, sub / n, ev, tm / n / ev, asleep / n);
+    std::printf("| %s | %d | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g | %.3g |\n", name, n, tm / n,
+                tr / n, (tm + tr) / n, mx, it / n, sub / n, ev, tm / n / ev);
   };
   for (const Phase& p : kPhases) row(p.name, p.begin, p.end);
   row("whole run", 0.0, 1e9);

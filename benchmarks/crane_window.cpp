@@ -1,5 +1,5 @@
-// A short window of the crane scene, for instruction counts (issue 14,
-// docs/benchmarks.md section 4): the remanence phase after the coil is off
+// A short window of the crane scene, for instruction counts
+// (docs/benchmarks.md "Where the crane's time goes"): the remanence phase after the coil is off
 // costs most of the run, and reaching it takes thousands of steps, so the
 // state at the window's start is saved once and the window replayed from it.
 //
@@ -7,14 +7,13 @@
 //       runs the scene to time T and writes the rigid bodies' states and the
 //       magnetic moments to FILE (binary, not portable; a scratch file).
 //   crane_window --scene PATH --snapshot FILE --steps N [--magnetization-scale S]
-//       [--threads N] [--label TEXT] [--old] [--no-precondition]
+//       [--threads N] [--label TEXT] [--no-precondition]
 //       rebuilds the scene without its time line (the crane held where its
 //       track ends, at magnetization scale S, default 0: coil off), puts the
 //       saved states back, and steps N times. Under valgrind --tool=callgrind
 //       --instr-atstart=no only these steps are counted. Prints the window's
 //       T_m, T_r, outer iterations, substeps, balls above 0.1 m, and an
-//       FNV-1a hash of the final positions. --old: the relaxation as before
-//       issue 14 (use_solver_before_issue_14); --no-precondition: without the
+//       FNV-1a hash of the final positions. --no-precondition: without the
 //       outer loop's block preconditioner (RelaxOptions::precondition_bodies).
 //   crane_window --scene PATH --steps N [--duration-start 0]
 //       without --snapshot: the first N steps of the scene as it is.
@@ -61,9 +60,6 @@ double process_cpu_s() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// The relaxation as before issue 14's changes (the levers' switches).
-void use_solver_before_issue_14(RelaxOptions& o) { o.local.polish_isotropic_pairs = true; }
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -72,7 +68,7 @@ int main(int argc, char** argv) {
               label = "window";
   double save_at = -1.0, scale = 0.0;
   int steps = 100, threads = 2;
-  bool old_solver = false, histories = false, plain = false;
+  bool histories = false, plain = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--scene") scene_path = bench::option_value(argc, argv, i, "crane_window");
@@ -82,7 +78,6 @@ int main(int argc, char** argv) {
     else if (a == "--threads") threads = std::stoi(bench::option_value(argc, argv, i, "crane_window"));
     else if (a == "--magnetization-scale") scale = std::stod(bench::option_value(argc, argv, i, "crane_window"));
     else if (a == "--label") label = bench::option_value(argc, argv, i, "crane_window");
-    else if (a == "--old") old_solver = true;
     else if (a == "--histories") histories = true;
     else if (a == "--no-precondition") plain = true;
     else {
@@ -92,8 +87,7 @@ int main(int argc, char** argv) {
   }
   SceneDescription scene = load_scene(scene_path);
   scene.solver.threads = threads;
-  if (old_solver) use_solver_before_issue_14(scene.solver.relax);
-  if (plain || old_solver) scene.solver.relax.precondition_bodies = false;
+  if (plain) scene.solver.relax.precondition_bodies = false;
   const bool saving = save_at >= 0.0, replaying = !saving && !snapshot.empty();
   if (saving) {
     Simulation sim(scene);
@@ -196,7 +190,7 @@ int main(int argc, char** argv) {
   const double cpu = process_cpu_s() - cpu0;
   double tm = 0, tr = 0, tmax = 0;
   long it = 0, sub = 0, maxit = 0, llg = 0, newton = 0;
-  for (const StepRecord& r : sim.records()) {
+  for (const StepReport& r : sim.records()) {
     tm += r.magnetic_ms, tr += r.rigid_ms, tmax = std::max(tmax, r.magnetic_ms + r.rigid_ms);
     it += r.iterations, sub += r.substeps, maxit = std::max<long>(maxit, r.iterations);
     llg += r.llg_steps, newton += r.newton_steps;

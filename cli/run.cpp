@@ -280,8 +280,7 @@ const std::vector<std::string>& summary_figures() {
     std::vector<std::string> f = {"bodies", "cells", "responsive_cells", "time_step", "duration", "steps",
                                   "frames", "wall_seconds", "steps_not_converged", "magnetic_steps_skipped",
                                   "exact_solver_failures"};
-    for (const char* group : {"magnetic_ms", "rigid_ms", "iterations", "substeps", "sleeping",
-                              "held", "whole_step", "rezoned"})
+    for (const char* group : {"magnetic_ms", "rigid_ms", "iterations", "substeps", "held", "rezoned"})
       for (const char* s : {"median", "p90", "mean", "max", "total"}) f.push_back(std::string(group) + "." + s);
     return f;
   }();
@@ -352,16 +351,14 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
 
   // summary.json: the cost of every rigid step and the scene's outcomes
   // (summary_figures() lists its numbers for sweeps: keep the two together).
-  std::vector<double> tm, tr, iterations, substeps, sleeping, held, whole_step, rezoned;
+  std::vector<double> tm, tr, iterations, substeps, held, rezoned;
   long not_converged = 0, skipped = 0;
-  for (const StepRecord& r : sim.records()) {
+  for (const StepReport& r : sim.records()) {
     tm.push_back(r.magnetic_ms);
     tr.push_back(r.rigid_ms);
     iterations.push_back(r.iterations);
     substeps.push_back(r.substeps);
-    sleeping.push_back(r.sleeping);
     held.push_back(r.held);
-    whole_step.push_back(r.whole_step);
     rezoned.push_back(r.rezoned);
     if (!r.converged) ++not_converged;
     skipped += r.skipped;
@@ -387,11 +384,8 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
       {"rigid_ms", statistics(tr)},
       {"iterations", statistics(iterations)},
       {"substeps", statistics(substeps)},  // one relaxation per substep
-      {"sleeping", statistics(sleeping)},  // bodies asleep at a step's end (simulation.sleep)
       // bodies held over a step's later substeps (magnetic_solve "moving")
       {"held", statistics(held)},
-      // free bodies that took the step whole (rigid_substeps "moving")
-      {"whole_step", statistics(whole_step)},
       // bodies whose refined contact zones moved to their contacts (solver.contact_refinement)
       {"rezoned", statistics(rezoned)},
       {"steps_not_converged", not_converged},

@@ -129,7 +129,7 @@ std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene, co
   std::string notice;
   std::unique_ptr<MagneticBackend> backend;
   try {
-    backend = make_backend(o.backend.value_or(scene.solver.backend),
+    backend = make_backend(o.backend ? backend_kind(*o.backend) : scene.solver.backend,
                            o.threads.value_or(scene.solver.threads), &notice, cpu_only_feature(scene));
   } catch (const std::invalid_argument& e) {
     if (o.backend) throw UsageError(std::string("--backend: ") + e.what());

@@ -12,16 +12,10 @@
 #include <vector>
 
 #include "magnetics/model/model.h"
+#include "odemag/settings.h"
 #include "odemag/vec3.h"
 
 namespace odemag {
-
-struct SubstepSettings {
-  // Cap on the count; 1 disables substepping (SimulationSettings::max_substeps).
-  int max_substeps = 64;
-  // Bound on omega h for the magnetic force and torque (SimulationSettings::stiffness_limit).
-  double stiffness_limit = 1.0;
-};
 
 // What the rule knows of a body that does not change while it moves.
 struct SubstepBody {

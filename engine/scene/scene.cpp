@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "magnetics/materials/bh_curve.h"
+#include "magnetics/model/model.h"
 #include "odemag/constants.h"
 
 namespace odemag {
@@ -374,7 +375,7 @@ using Slot = std::variant<double*, std::optional<double>*, int*, bool*, std::str
 
 // How a plain key's value is checked; custom: the rule's own reader.
 enum class Check {
-  custom, number, positive, non_negative, in_range, integer, boolean, string, non_empty_string, choice,
+  custom, number, positive, non_negative, in_range, integer, boolean, string, non_empty_string,
   vec3, non_zero_vec3, color, quaternion
 };
 
@@ -394,8 +395,6 @@ struct KeyRule {
   void (*read)(const SceneReader&, const json&, const std::string&, T&) = nullptr;  // Check::custom
   double lo = 0.0, hi = 0.0;                  // in_range, integer
   Magnitude bound = {};                       // number, positive, non_negative, vec3: largest magnitude
-  // choice: the words, then empty ones (a std::vector here crashes GCC 12).
-  std::array<std::string_view, 4> words{};
   bool required = false;
   // Read after the other keys: of several bad values the one reported first
   // stays the one reported before the tables (solver.far_field_theta after
@@ -406,6 +405,31 @@ struct KeyRule {
 
 template <class T>
 using KeyTable = std::vector<KeyRule<T>>;
+
+// A key whose value is one of a few words, each naming a value of an enum:
+// the pairs in the order that "is not one of" messages list the words.
+template <class E, size_t N>
+using Choices = std::array<std::pair<std::string_view, E>, N>;
+
+template <class E, size_t N>
+E read_choice(const SceneReader& r, const json& x, const std::string& p, const Choices<E, N>& choices) {
+  std::vector<std::string_view> words;
+  for (const auto& choice : choices) words.push_back(choice.first);
+  const std::string word = r.choice(x, p, words);
+  for (const auto& choice : choices)
+    if (word == choice.first) return choice.second;
+  return choices[0].second;  // r.choice throws on any other word
+}
+
+const Choices<BackendKind, 3> kBackendChoices = {
+    {{"cpu", BackendKind::cpu}, {"cuda", BackendKind::cuda}, {"auto", BackendKind::automatic}}};
+const Choices<ContactSolver, 3> kContactSolverChoices = {
+    {{"auto", ContactSolver::automatic}, {"quick", ContactSolver::quick}, {"exact", ContactSolver::exact}}};
+const Choices<MagneticSolve, 2> kMagneticSolveChoices = {
+    {{"substep", MagneticSolve::substep}, {"moving", MagneticSolve::moving}}};
+using Statistic = OutcomeDescription::Statistic;
+const Choices<Statistic, 3> kStatisticChoices = {
+    {{"max", Statistic::max}, {"min", Statistic::min}, {"mean", Statistic::mean}}};
 
 // The slot of a plain key: SLOT(relax.tolerance).
 #define SLOT(field) [](auto& t) -> Slot { return &t.field; }
@@ -457,12 +481,6 @@ void read_value(const SceneReader& r, const KeyRule<T>& rule, const json& x, con
     case Check::boolean: return store(slot, r.boolean(x, p));
     case Check::string: return store(slot, r.string(x, p));
     case Check::non_empty_string: return store(slot, r.non_empty_string(x, p));
-    case Check::choice: {
-      std::vector<std::string_view> words;
-      for (std::string_view w : rule.words)
-        if (!w.empty()) words.push_back(w);
-      return store(slot, r.choice(x, p, words));
-    }
     case Check::vec3: return store(slot, r.bounded(r.vec3(x, p), p, rule.bound));
     case Check::non_zero_vec3: return store(slot, r.bounded(r.non_zero_vec3(x, p), p, rule.bound));
     case Check::color: return store(slot, r.color(x, p));
@@ -933,15 +951,14 @@ const KeyTable<SolverSettings> kSolverKeys = {
      .doc = {"bool", "", "`false`"}},
     {.name = "near_field", .check = Check::boolean, .slot = SLOT(relax.near_field),
      .doc = {"bool", "", "`true`"}},
-    {.name = "precondition_bodies", .check = Check::boolean, .slot = SLOT(relax.precondition_bodies),
-     .doc = {"bool", "", "`true`"}},
-    {.name = "predict_warm_start", .check = Check::boolean, .slot = SLOT(relax.predict_warm_start),
-     .doc = {"bool", "", "`true`"}},
     {.name = "graded_cells", .check = Check::boolean, .slot = SLOT(graded_cells),
      .doc = {"bool", "", "`false`"}},
     {.name = "contact_refinement", .check = Check::boolean, .slot = SLOT(contact_refinement),
      .doc = {"bool", "", "`false`"}},
-    {.name = "backend", .check = Check::choice, .slot = SLOT(backend), .words = {"cpu", "cuda", "auto"},
+    {.name = "backend",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SolverSettings& s) {
+       s.backend = read_choice(r, x, p, kBackendChoices);
+     },
      .late = true, .doc = {"string", "", "`\"auto\"`"}},
     {.name = "threads", .check = Check::integer, .slot = SLOT(threads),
      .lo = 0, .hi = 65536, .late = true,
@@ -961,17 +978,6 @@ const KeyTable<ContactSettings> kContactKeys = {
      .doc = {"number", "m", "`1e-5`"}},
     {.name = "spinning_friction", .check = Check::non_negative, .slot = SLOT(spinning_friction),
      .doc = {"number", "m", "as `rolling_friction`"}},
-    {.name = "rolling_axes", .check = Check::choice, .slot = SLOT(rolling_axes), .words = {"both", "rolling"},
-     .doc = {"string", "", "`\"both\"`"}},
-};
-
-const KeyTable<SleepSettings> kSleepKeys = {
-    {.name = "time", .check = Check::non_negative, .slot = SLOT(time),
-     .doc = {"number", "s", "`0`"}},
-    {.name = "speed", .check = Check::positive, .slot = SLOT(speed), .bound = kSpeed,
-     .doc = {"number", "m/s", "`0.005`"}},
-    {.name = "wake_force", .check = Check::positive, .slot = SLOT(wake_force),
-     .doc = {"number", "", "`0.05`"}},
 };
 
 const KeyTable<SimulationSettings> kSimulationKeys = {
@@ -981,8 +987,11 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
      .doc = {"number", "s", "`2`"}},
     {.name = "frame_rate", .check = Check::positive, .slot = SLOT(frame_rate),
      .doc = {"number", "1/s", "`30`"}},
-    {.name = "contact_solver", .check = Check::choice, .slot = SLOT(contact_solver),
-     .words = {"auto", "quick", "exact"}, .doc = {"string", "", "`\"auto\"`"}},
+    {.name = "contact_solver",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SimulationSettings& s) {
+       s.contact_solver = read_choice(r, x, p, kContactSolverChoices);
+     },
+     .doc = {"string", "", "`\"auto\"`"}},
     {.name = "solver_iterations", .check = Check::integer, .slot = SLOT(solver_iterations), .lo = 1,
      .hi = 1000000, .doc = {"integer", "", "`30`"}},
     {.name = "ground", .check = Check::boolean, .slot = SLOT(ground), .doc = {"bool", "", "`true`"}},
@@ -993,11 +1002,6 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
        read_object(r, x, p, kContactKeys, s.contact);
      },
      .doc = {"object", "", ""}},
-    {.name = "sleep",
-     .read = [](const SceneReader& r, const json& x, const std::string& p, SimulationSettings& s) {
-       read_object(r, x, p, kSleepKeys, s.sleep);
-     },
-     .doc = {"object", "", ""}},
     {.name = "linear_damping", .check = Check::in_range, .slot = SLOT(linear_damping), .lo = 0.0, .hi = 1.0,
      .doc = {"number", "", "`0`"}},
     {.name = "angular_damping", .check = Check::in_range, .slot = SLOT(angular_damping), .lo = 0.0, .hi = 1.0,
@@ -1006,10 +1010,11 @@ const KeyTable<SimulationSettings> kSimulationKeys = {
      .doc = {"integer", "", "`64`"}},
     {.name = "stiffness_limit", .check = Check::positive, .slot = SLOT(stiffness_limit),
      .doc = {"number", "", "`1`"}},
-    {.name = "magnetic_solve", .check = Check::choice, .slot = SLOT(magnetic_solve),
-     .words = {"substep", "step", "moving"}, .doc = {"string", "", "`\"substep\"`"}},
-    {.name = "rigid_substeps", .check = Check::choice, .slot = SLOT(rigid_substeps),
-     .words = {"all", "moving"}, .doc = {"string", "", "`\"all\"`"}},
+    {.name = "magnetic_solve",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, SimulationSettings& s) {
+       s.magnetic_solve = read_choice(r, x, p, kMagneticSolveChoices);
+     },
+     .doc = {"string", "", "`\"substep\"`"}},
 };
 
 const KeyTable<CameraSettings> kCameraKeys = {
@@ -1291,7 +1296,10 @@ const KeyTable<OutcomeTarget> kOutcomeKeys = {
     {.name = "force", .read = read_quantity<5>, .doc = {"object", "", ""}},
     {.name = "moment", .read = read_quantity<6>, .doc = {"object", "", ""}},
     {.name = "time", .check = Check::number, .slot = SLOT(outcome.time), .doc = {"number", "s", "`-1`"}},
-    {.name = "statistic", .check = Check::choice, .slot = SLOT(outcome.statistic), .words = {"max", "min", "mean"},
+    {.name = "statistic",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, OutcomeTarget& t) {
+       t.outcome.statistic = read_choice(r, x, p, kStatisticChoices);
+     },
      .doc = {"string", "", "`\"\"`"}},
     {.name = "from", .check = Check::non_negative, .slot = SLOT(outcome.from), .doc = {"number", "s", "`0`"}},
 };
@@ -1306,9 +1314,9 @@ OutcomeDescription read_outcome(const SceneReader& r, const json& v, const std::
                  "moment (it has " + std::to_string(quantities) + ")");
   OutcomeTarget t{{}, scene, index};
   read_object(r, v, path, kOutcomeKeys, t);
-  if (!t.outcome.statistic.empty() && v.contains("time"))
+  if (t.outcome.statistic != Statistic::none && v.contains("time"))
     r.fail(member(path, "time"), "an outcome with a statistic (max, min, mean over the run) has no time");
-  if (t.outcome.statistic.empty() && v.contains("from"))
+  if (t.outcome.statistic == Statistic::none && v.contains("from"))
     r.fail(member(path, "from"), "only an outcome with a statistic (max, min, mean) has a start time");
   return t.outcome;
 }
@@ -1496,7 +1504,6 @@ std::vector<SceneKeyDoc> scene_key_docs() {
   add_key_docs(docs, "solver", kSolverKeys);
   add_key_docs(docs, "simulation", kSimulationKeys);
   add_key_docs(docs, "simulation.contact", kContactKeys);
-  add_key_docs(docs, "simulation.sleep", kSleepKeys);
   for (const EventAction& a : kEventActions)
     add_key_docs(docs, std::string("timeline[].") + a.action, *a.keys);
   add_key_docs(docs, "timeline[].keys[]", kKeyframeKeys);

@@ -12,8 +12,8 @@
 
 #include "magnetics/sources/coil.h"
 #include "odemag/material.h"
-#include "magnetics/relax/relax.h"
 #include "odemag/shape.h"
+#include "odemag/settings.h"
 #include "odemag/vec3.h"
 
 namespace odemag {
@@ -66,7 +66,7 @@ struct JointDescription {
 
 struct SolverSettings {
   RelaxOptions relax;          // scheme, tolerance, max_iterations, mutual_induction, ...
-  std::string backend = "auto";  // "cpu", "cuda", "auto"
+  BackendKind backend = BackendKind::automatic;  // "auto", "cpu", "cuda"
   int threads = 0;             // 0: all cores
   // Graded cells for responsive boxes (MagneticModel::set_graded_cells,
   // docs/model.md "Graded cells"); CPU backend only ("auto" then picks it).
@@ -89,22 +89,6 @@ struct ContactSettings {
   // force (ODE rhoN); below 0 (the default): rolling_friction.
   double spinning_friction = -1.0;
   double spinning() const { return spinning_friction < 0.0 ? rolling_friction : spinning_friction; }
-  // The axes of the rolling resistance (docs/simulation.md "Contacts"):
-  // "both", a row about each of the contact's two tangent directions (ODE's
-  // pyramid: sqrt 2 times the torque along their diagonal); "rolling", one
-  // row about the axis the two bodies roll about relative to each other at
-  // the substep's start (the torque rho N along any direction, one row
-  // fewer), both rows while they do not roll.
-  std::string rolling_axes = "both";
-};
-
-// Sleeping bodies (docs/simulation.md "Sleeping bodies"): a group of bodies
-// touching each other that has stayed slow for `time` is taken out of ODE's
-// step until something wakes it.
-struct SleepSettings {
-  double time = 0.0;           // s below `speed` before a contact group sleeps; 0: never
-  double speed = 0.005;        // m/s: |v| + |omega| r, r the body's bounding radius
-  double wake_force = 0.05;    // wake when the applied force moves this fraction of the weight
 };
 
 struct SimulationSettings {
@@ -116,12 +100,11 @@ struct SimulationSettings {
   // to 32 dynamic bodies, quick beyond). docs/simulation.md: with strong
   // magnetic forces pressing balls together quick throws some out at 3-7 m/s
   // where exact throws none, and for small scenes exact is also faster.
-  std::string contact_solver = "auto";
+  ContactSolver contact_solver = ContactSolver::automatic;
   int solver_iterations = 30;
   bool ground = true;         // a ground plane z = ground_height
   double ground_height = 0.0;
   ContactSettings contact;
-  SleepSettings sleep;
   double linear_damping = 0.0;
   double angular_damping = 0.0;
   // A rigid step is split into substeps, each with its own magnetic forces
@@ -130,16 +113,9 @@ struct SimulationSettings {
   // time (omega h <= stiffness_limit, omega^2 = |F| / (m size)). 1 disables.
   int max_substeps = 64;
   double stiffness_limit = 1.0;  // bound on omega h for the magnetic force (see above)
-  // When the magnetization is relaxed (docs/simulation.md "Substeps"):
-  // "substep", at every substep; "step", once per rigid step, the later
-  // substeps recomputing forces and torques at the new positions with the
-  // magnetization of the step's start.
-  std::string magnetic_solve = "substep";
-  // Which bodies take the substeps (docs/simulation.md "Substeps"): "all";
-  // or "moving", the free bodies that need them (for this and the last hold
-  // time) and those touching one, while every other free body takes the
-  // rigid step whole and rides through the substeps on its path.
-  std::string rigid_substeps = "all";
+  // When the magnetization is relaxed (MagneticSolve, docs/simulation.md
+  // "Substeps"): "substep" or "moving".
+  MagneticSolve magnetic_solve = MagneticSolve::substep;
 };
 
 // A keyframe of a scripted (kinematic) body.
@@ -184,9 +160,6 @@ struct RenderSettings {
   bool force_colors = false;  // bodies coloured by force magnitude (teal..yellow, docs/rendering.md)
 };
 
-// A number the scene reports in summary.json: how many bodies whose names start
-// with `prefix` have their centre above `height` (m) at time `time`
-// (negative: the end of the run).
 // A number a run reports in its summary (docs/scene-format.md "outcomes").
 struct OutcomeDescription {
   enum class Quantity {
@@ -205,7 +178,10 @@ struct OutcomeDescription {
   std::vector<std::string> bodies;  // the body; two for distance
   int component = -1;               // force, moment: 0, 1, 2 for x, y, z; -1: the magnitude
   double time = -1.0;               // s; when to evaluate; negative: at the end of the run
-  std::string statistic;            // "max", "min" or "mean" over every step from `from` on; "": at `time`
+  // Over every step from `from` on: the largest, the smallest, the mean; or
+  // none, the value at `time`.
+  enum class Statistic { none, max, min, mean };
+  Statistic statistic = Statistic::none;
   double from = 0.0;                // s; a statistic's first sample (steps at t >= from)
 };
 

@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "engine/simulation/simulation.h"
+#include "engine/simulation/timeline.h"
 #include "gpu/cuda_backend.h"
 #include "magnetics/cells/cells.h"
 
@@ -101,23 +101,34 @@ MagneticSystem build_magnetic_system(const SceneDescription& scene) {
   return ms;
 }
 
-void apply_events_at_start(const SceneDescription& scene, MagneticSystem& system, RelaxOptions& options) {
-  for (const TimelineEvent& e : scene.timeline) {
-    const int body = e.body.empty() ? -1 : scene.find_body(e.body);
-    if (e.kind == TimelineEvent::Kind::keyframes) {
-      system.state.pose[body] = keyframe_pose(e.keys, 0.0);
-      continue;
-    }
-    if (e.time != 0.0 || e.end_time != 0.0) continue;  // later, or a ramp (at its start value at t = 0)
-    switch (e.kind) {
-      case TimelineEvent::Kind::add_body: system.state.active[body] = 1; break;
-      case TimelineEvent::Kind::remove_body: system.state.active[body] = 0; break;
-      case TimelineEvent::Kind::scale_magnetization: system.state.magnetization_scale[body] = e.value; break;
-      case TimelineEvent::Kind::mutual_induction: options.mutual_induction = e.enabled; break;
-      case TimelineEvent::Kind::external_field: system.state.external_field = e.field; break;
-      case TimelineEvent::Kind::keyframes: break;
-    }
+namespace {
+
+// The time line's target at t = 0 when nothing moves: the system's state and
+// the relaxation options.
+class TimelineOnSystem : public TimelineTarget {
+ public:
+  TimelineOnSystem(MagneticSystem& system, RelaxOptions& options) : state_(system.state), options_(options) {}
+  void set_present(int body, bool present) override { state_.active[body] = present ? 1 : 0; }
+  double magnetization_scale(int body) const override { return state_.magnetization_scale[body]; }
+  void set_magnetization_scale(int body, double scale) override { state_.magnetization_scale[body] = scale; }
+  Vec3 external_field() const override { return state_.external_field; }
+  void set_external_field(const Vec3& H) override { state_.external_field = H; }
+  void set_mutual_induction(bool enabled) override { options_.mutual_induction = enabled; }
+  void follow_track(int body, bool on_track, const BodyPose& pose, const Vec3&, const Vec3&) override {
+    if (on_track) state_.pose[body] = pose;
   }
+
+ private:
+  MagneticState& state_;
+  RelaxOptions& options_;
+};
+
+}  // namespace
+
+void apply_events_at_start(const SceneDescription& scene, MagneticSystem& system, RelaxOptions& options) {
+  Timeline timeline(scene);
+  TimelineOnSystem target(system, options);
+  timeline.apply(0.0, scene.simulation.time_step, target);
   place_cells(system.model, system.state);
 }
 
@@ -156,20 +167,24 @@ std::string cpu_only_feature(const SceneDescription& scene) {
   return "";
 }
 
-std::unique_ptr<MagneticBackend> make_backend(const std::string& name, int threads,
-                                              std::string* notice, const std::string& cpu_only) {
-  if (name == "cpu") return make_cpu_backend(threads);
-  if (!cpu_only.empty() && name == "cuda")
-    throw std::invalid_argument("backend \"cuda\" does not support " + cpu_only);
-  if (!cpu_only.empty() && name == "auto") return make_cpu_backend(threads);
-  if (name == "cuda" || name == "auto") {
-    std::string why;
-    if (auto gpu = make_cuda_backend(&why)) return gpu;
-    if (name == "cuda") throw std::invalid_argument("backend \"cuda\" is not available: " + why);
-    if (notice) *notice = "odemag: no CUDA device (" + why + "); using the CPU backend";
-    return make_cpu_backend(threads);
-  }
+BackendKind backend_kind(const std::string& name) {
+  if (name == "cpu") return BackendKind::cpu;
+  if (name == "cuda") return BackendKind::cuda;
+  if (name == "auto") return BackendKind::automatic;
   throw std::invalid_argument("unknown backend \"" + name + "\" (cpu, cuda or auto)");
+}
+
+std::unique_ptr<MagneticBackend> make_backend(BackendKind kind, int threads, std::string* notice,
+                                              const std::string& cpu_only) {
+  if (kind == BackendKind::cpu) return make_cpu_backend(threads);
+  if (!cpu_only.empty() && kind == BackendKind::cuda)
+    throw std::invalid_argument("backend \"cuda\" does not support " + cpu_only);
+  if (!cpu_only.empty()) return make_cpu_backend(threads);
+  std::string why;
+  if (auto gpu = make_cuda_backend(&why)) return gpu;
+  if (kind == BackendKind::cuda) throw std::invalid_argument("backend \"cuda\" is not available: " + why);
+  if (notice) *notice = "odemag: no CUDA device (" + why + "); using the CPU backend";
+  return make_cpu_backend(threads);
 }
 
 }  // namespace odemag

@@ -4,6 +4,8 @@
 
 namespace odemag {
 
+using Statistic = OutcomeDescription::Statistic;
+
 namespace {
 
 // A component (0, 1, 2) of v, or its length (-1).
@@ -41,12 +43,12 @@ void OutcomeRecorder::sample(const SceneDescription& scene, double time, double 
                              const MagneticForces& magnetics) {
   for (size_t i = 0; i < scene.outcomes.size(); ++i) {
     const OutcomeDescription& o = scene.outcomes[i];
-    if (!o.statistic.empty()) {
+    if (o.statistic != Statistic::none) {
       if (time + 0.5 * dt < o.from) continue;
       const double v = outcome_value(o, scene, world, magnetics);
       if (!seen_[i]) running_[i] = v;
-      else if (o.statistic == "max") running_[i] = std::max(running_[i], v);
-      else if (o.statistic == "min") running_[i] = std::min(running_[i], v);
+      else if (o.statistic == Statistic::max) running_[i] = std::max(running_[i], v);
+      else if (o.statistic == Statistic::min) running_[i] = std::min(running_[i], v);
       else running_[i] += v;  // mean: the sum, divided at the end
       ++seen_[i];
     } else if (o.time >= 0.0 && !values_.count(o.name) && time + 0.5 * dt >= o.time) {
@@ -59,9 +61,9 @@ void OutcomeRecorder::finish(const SceneDescription& scene, const RigidWorld& wo
   for (size_t i = 0; i < scene.outcomes.size(); ++i) {
     const OutcomeDescription& o = scene.outcomes[i];
     if (values_.count(o.name)) continue;
-    if (!o.statistic.empty()) {
+    if (o.statistic != Statistic::none) {
       if (seen_[i]) {
-        values_[o.name] = o.statistic == "mean" ? running_[i] / static_cast<double>(seen_[i]) : running_[i];
+        values_[o.name] = o.statistic == Statistic::mean ? running_[i] / static_cast<double>(seen_[i]) : running_[i];
       } else if (o.from <= 0.0) {  // no step taken: the state now
         values_[o.name] = outcome_value(o, scene, world, magnetics);
       }  // a start time the run did not reach: left out

@@ -1,6 +1,7 @@
-// Settings of the magnetic solve: the relaxation of the magnetization and its
-// report (docs/model.md "Relaxation"). Plain structs with their defaults, so
-// that no header includes a solver for a setting.
+// Settings: of the relaxation of the magnetization and its report
+// (docs/model.md), of the step loop (docs/simulation.md "Substeps") and the
+// choices of a scene's solver. Plain structs and enums with their defaults,
+// so that no header includes a solver for a setting.
 #pragma once
 
 #include <cstdint>
@@ -22,12 +23,6 @@ struct LocalRelaxOptions {
   double tolerance = 1e-12;        // relative torque at which a cell is relaxed
   double noise_ratio = 1e-6;       // |H_noise| / |H_eff| (paper Sec. 4.6)
   bool single_step = false;        // exactly one LLG step (paper Algorithm 1)
-  // Isotropic cells (H_K = 0) with opposite pairs of moments (n even) end on
-  // their exact minimum (isotropic_minimum), which fixes M from H_A alone;
-  // false: the Newton polish runs before it as well, as before issue 14 (it
-  // moved only the pair axes, and was most of the Newton steps of the crane's
-  // remanence phase: docs/benchmarks.md section 4).
-  bool polish_isotropic_pairs = false;
 };
 
 enum class RelaxScheme {
@@ -74,27 +69,24 @@ struct RelaxOptions {
   // Block preconditioner of the outer loop: high-chi isotropic lattice bodies
   // below saturation get a Newton step for their own linear response
   // (magnetics/model/body_response.h, docs/model.md "Block preconditioner").
-  // false: Anderson on the plain residual, as before.
+  // Always on in scenes; false (Anderson on the plain residual) only to
+  // measure what it saves (benchmarks/relax_iterations.cpp).
   bool precondition_bodies = true;
   // The outer loop starts from the warm start's applied field plus what the
   // last relaxation added to it, where the last two relaxations added alike
   // (MagneticState::relaxation_change, docs/model.md "Predicted warm
-  // start"). false: from the warm start's field, as before.
+  // start"). Always on in scenes; false (from the warm start's field) only
+  // to measure what it saves.
   bool predict_warm_start = true;
   // Bodies whose magnetization is kept, turned with the body but not solved
   // for (by body index, kHeld: held; empty: none): their cells act as sources
   // and feel forces, and the relaxation converges on the others' cells.
-  // kHeldKeepForce: held, and its force and torque are not needed (a body
-  // that the rigid step moved whole): they keep their values, and a backend
-  // may skip what only they need (the near-field pairs of two such bodies).
-  // The scene simulation's magnetic_solve "moving" holds, in a rigid step's
-  // later substeps, every body that neither needs the substeps nor touches
-  // one that does, and rigid_substeps "moving" keeps the forces of the bodies
-  // that took the step whole (docs/simulation.md "Substeps"). Non-empty: one
-  // entry (0, kHeld or kHeldKeepForce) per body, or relax, magnetic_step and
-  // magnetic_forces_at_held_magnetization throw std::invalid_argument
-  // before they change anything.
-  static constexpr uint8_t kHeld = 1, kHeldKeepForce = 2;
+  // MagneticSolve::moving holds, in a rigid step's later substeps, every body
+  // that neither needs the substeps nor touches one that does
+  // (docs/simulation.md "Substeps"). Non-empty: one entry (0 or kHeld) per
+  // body, or relax, magnetic_step and magnetic_forces_at_held_magnetization
+  // throw std::invalid_argument before they change anything.
+  static constexpr uint8_t kHeld = 1;
   std::vector<uint8_t> held_bodies;
   LocalRelaxOptions local;
   // Called after every outer iteration with the report so far (iterations,
@@ -112,5 +104,37 @@ struct RelaxReport {
   long newton_steps = 0;      // per-cell Newton steps, summed over cells
   std::vector<double> residual_history;  // the convergence measure after each iteration
 };
+
+// The substep rule (docs/simulation.md "Substeps").
+struct SubstepSettings {
+  // Cap on the count; 1 disables substepping (scene simulation.max_substeps).
+  int max_substeps = 64;
+  // Bound on omega h for the magnetic force and torque (scene simulation.stiffness_limit).
+  double stiffness_limit = 1.0;
+};
+
+// When the magnetization is relaxed within a rigid step (scene
+// simulation.magnetic_solve, docs/simulation.md "Substeps"): substep, at
+// every substep for every body; moving, at every substep for the bodies that
+// need the substeps and those touching them, the others' magnetization held
+// (RelaxOptions::held_bodies) in the later substeps.
+enum class MagneticSolve { substep, moving };
+
+// The step loop (MagneticStepper).
+struct StepperSettings {
+  SubstepSettings substeps;
+  MagneticSolve magnetic_solve = MagneticSolve::substep;
+  bool exact_solver = false;  // embedders: dWorldStep instead of dWorldQuickStep
+};
+
+// The magnetic backend (scene solver.backend, docs/gpu.md): automatic, the
+// CUDA backend where a device is usable and the scene needs nothing it lacks,
+// else the CPU backend.
+enum class BackendKind { automatic, cpu, cuda };
+
+// ODE's constraint solver for contacts (scene simulation.contact_solver,
+// docs/simulation.md "Contacts"): automatic, exact up to 32 dynamic bodies
+// and quick beyond.
+enum class ContactSolver { automatic, exact, quick };
 
 }  // namespace odemag

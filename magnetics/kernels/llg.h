@@ -361,8 +361,7 @@ ODEMAG_HD int newton_polish(const SoftCellParams& p, const Vec3& H_A, Vec3* m, i
 // t H_A/|H_A|, t = min(|H_A| / (gamma_D Ms), 1), with each opposite pair
 // (m_2j, m_2j+1) placed symmetrically about H_A and its axis turned as little
 // as possible. Applied instead of the Newton polish where every moment has
-// its pair (n even), after it otherwise (or with
-// LocalRelaxOptions::polish_isotropic_pairs). The polish cannot resolve weak
+// its pair (n even), after it otherwise. The polish cannot resolve weak
 // fields: the curvature of the pair-axis mode, |H_A|^2 / (gamma_D Ms), is
 // lost to round-off next to gamma_D Ms, so for iron the polish stopped with M
 // 13-32% off at 1e-4..1e-2 A/m and 2e-7 off at 1 A/m, where its torque
@@ -420,7 +419,7 @@ ODEMAG_HD LocalRelaxResult relax_soft_cell(const SoftCellParams& p, const Vec3& 
   // An isotropic cell of opposite pairs has one minimum, put in closed form
   // below: mean(m) = min(|H_A| / (gamma_D Ms), 1) H_A / |H_A| whatever the
   // pair axes, so a polish would turn only the axes.
-  const bool closed_form = o.newton && p.H_K == 0.0 && p.n % 2 == 0 && !o.polish_isotropic_pairs;
+  const bool closed_form = o.newton && p.H_K == 0.0 && p.n % 2 == 0;
   if (o.newton && !closed_form)
     r.newton_steps = newton_polish(p, H_A, m, o.max_newton_steps, o.tolerance, r.residual);
   if (o.newton && p.H_K == 0.0) {

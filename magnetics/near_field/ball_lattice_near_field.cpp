@@ -545,7 +545,6 @@ class BallLatticeNearField final : public NearFieldTerm {
                   std::vector<Vec3>& field) const override {
     std::vector<Vec3> torque(cached_.size());
     for_each_pair([&](const BallCellPair& p) {
-      if (both_keep_force(p.b, p.c)) return;
       const LatticeBody& lb = cached_[p.lattice];
       const Vec3 mu_b = p.volume_b * state.magnetization[p.b], mu_c = p.volume_c * state.magnetization[p.c];
       const Vec3 r = state.cell_position[p.b] - state.cell_position[p.c];

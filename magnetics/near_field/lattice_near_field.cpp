@@ -369,7 +369,6 @@ class LatticeNearField final : public NearFieldTerm {
                   std::vector<Vec3>& field) const override {
     std::vector<Vec3> body_torque(model.body_count());
     for (const CellPair& p : pairs_) {
-      if (both_keep_force(p.i, p.j)) continue;
       const BodyLink& l = links_[p.link];
       const Vec3 mu_i = moment(model, state, p.i), mu_j = moment(model, state, p.j);
       const Vec3 r = state.cell_position[p.i] - state.cell_position[p.j], &d = r;

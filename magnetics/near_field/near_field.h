@@ -66,21 +66,16 @@ class NearFieldTerm {
   // neighbour) is then left out. Takes effect at the next build.
   void set_mutual_induction(bool on) { mutual_induction_ = on; }
 
-  // By cell, 1 where the relaxation keeps the magnetization, 2 where it also
-  // keeps the body's force (RelaxOptions::held_bodies); nullptr or empty:
-  // none. add_field skips the pairs of two held cells, whose fields nothing
-  // reads; add_forces those of two cells held with 2, and build need not
-  // evaluate them. Set before build; until the next build the cells may
-  // only be cleared (an empty vector), not changed.
+  // By cell, 1 where the relaxation keeps the magnetization
+  // (RelaxOptions::held_bodies); nullptr or empty: none. add_field skips the
+  // pairs of two held cells, whose fields nothing reads. Set before build;
+  // until the next build the cells may only be cleared (an empty vector),
+  // not changed.
   void set_held_cells(const std::vector<uint8_t>* held) { held_cells_ = held; }
 
  protected:
   bool both_held(int a, int b) const {
     return held_cells_ && !held_cells_->empty() && (*held_cells_)[a] && (*held_cells_)[b];
-  }
-  bool both_keep_force(int a, int b) const {
-    return held_cells_ && !held_cells_->empty() && (*held_cells_)[a] == RelaxOptions::kHeldKeepForce &&
-           (*held_cells_)[b] == RelaxOptions::kHeldKeepForce;
   }
   bool mutual_induction_ = true;
   const std::vector<uint8_t>* held_cells_ = nullptr;

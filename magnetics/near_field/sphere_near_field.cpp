@@ -552,9 +552,6 @@ class SphereNearField final : public NearFieldTerm {
       const double delta = d - e.d0;
       const bool carried = e.evaluated && e.d0 > reach &&
                            std::fabs(delta) <= kReuseTolerance * std::min(e.d0 - reach, reach);
-      // Two spheres whose forces are kept: nothing reads this pair before
-      // the next build, so it is not evaluated (its last evaluation kept).
-      if (!carried && both_keep_force(ca.cell, cb.cell)) continue;
       corrected_.push_back(static_cast<int>(q));
       if (!both_held(ca.cell, cb.cell)) field_pairs_.push_back(static_cast<int>(q));
       // Coincident centres: any axis (the functions are constant there).

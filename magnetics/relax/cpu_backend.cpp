@@ -79,10 +79,8 @@ class CpuBackend final : public MagneticBackend {
       for (int b = 0; b < model.body_count(); ++b)
         std::fill_n(held_cell_.begin() + model.body(b).first_cell, model.body(b).cell_count(), held_[b]);
     }
-    // Before the build: the pairs of two bodies held with 2 are not evaluated.
     near_.set_held_cells(&held_cell_);
     near_.build(model, state, near_field_, near_mutual_induction_);
-    near_stale_ = std::find(held_.begin(), held_.end(), RelaxOptions::kHeldKeepForce) != held_.end();
   }
 
   void set_far_field(double theta) override { far_field_theta_ = theta; }
@@ -97,7 +95,6 @@ class CpuBackend final : public MagneticBackend {
   }
 
   void fixed_field(const MagneticModel& model, const MagneticState& state, std::vector<Vec3>& H) override {
-    refresh_near_field(model, state);
     const int n = resp_.size();
 #pragma omp parallel for schedule(static) num_threads(threads_) if (static_cast<long>(n) * fixed_.size() > kParallelPairs)
     for (int i = 0; i < n; ++i)
@@ -109,7 +106,6 @@ class CpuBackend final : public MagneticBackend {
 
   void responsive_field(const MagneticModel& model, const MagneticState& state,
                         std::vector<Vec3>& H) override {
-    refresh_near_field(model, state);
     const CellList& resp = layout_.responsive;
     resp_.load_moments(model, state, resp);
     const int n = resp_.size();
@@ -200,7 +196,6 @@ class CpuBackend final : public MagneticBackend {
   }
 
   void forces(const MagneticModel& model, MagneticState& state) override {
-    refresh_near_field(model, state);
     const CellList& all = layout_.all;
     all_.load_moments(model, state, all);
     const int n = all_.size();
@@ -209,7 +204,6 @@ class CpuBackend final : public MagneticBackend {
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads_) if (static_cast<long>(n) * n > kParallelPairs)
     for (int i = 0; i < n; ++i) {
       const CellRun& body = all.run_of(i);
-      if (keeps_force(all.body[i])) continue;  // its force is not needed (set_held_bodies)
       // Every cell of another body (pairs inside a body cancel).
       const Vec3 xi{all_.x[i], all_.y[i], all_.z[i]}, mi{all_.mx[i], all_.my[i], all_.mz[i]};
       const FieldAndForce before = sum_field_and_force(all_.sources(), 0, body.begin, xi, mi, all_.radius[i]);
@@ -261,16 +255,6 @@ class CpuBackend final : public MagneticBackend {
   std::vector<uint8_t> held_;      // by body: magnetization kept (set_held_bodies); empty: none
   std::vector<uint8_t> held_cell_;  // the same by cell, for the near field
   bool is_held(int b) const { return !held_.empty() && held_[b]; }
-  bool keeps_force(int b) const { return !held_.empty() && held_[b] == RelaxOptions::kHeldKeepForce; }
-  // The last build left the pairs of two bodies held with their forces
-  // unevaluated (near_stale_): once nothing is held any more (a field sum
-  // between steps), they are evaluated before the near field is read.
-  bool near_stale_ = false;
-  void refresh_near_field(const MagneticModel& model, const MagneticState& state) {
-    if (!near_stale_ || !held_.empty()) return;
-    near_.build(model, state, near_field_, near_mutual_induction_);
-    near_stale_ = false;
-  }
   bool use_tree_ = false;
   FarFieldTree tree_;
   std::vector<Vec3> tree_field_;

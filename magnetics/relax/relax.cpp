@@ -539,9 +539,9 @@ void place_cells_and_begin_step(const MagneticModel& model, MagneticState& state
     throw std::invalid_argument("RelaxOptions::held_bodies: " + std::to_string(o.held_bodies.size()) +
                                 " entries for " + std::to_string(model.body_count()) + " bodies");
   for (size_t b = 0; b < o.held_bodies.size(); ++b)
-    if (o.held_bodies[b] > RelaxOptions::kHeldKeepForce)
+    if (o.held_bodies[b] > RelaxOptions::kHeld)
       throw std::invalid_argument("RelaxOptions::held_bodies: entry " + std::to_string(b) + " is " +
-                                  std::to_string(o.held_bodies[b]) + " (0, 1 or 2)");
+                                  std::to_string(o.held_bodies[b]) + " (0 or 1)");
   place_cells(model, state);
   backend.set_far_field(o.far_field_theta);
   backend.set_near_field(o.near_field, o.mutual_induction);
@@ -578,16 +578,10 @@ RelaxReport solve(const MagneticModel& model, MagneticState& state, const RelaxO
   return relax_one_pass(model, state, o, backend, cells, H_fixed);
 }
 
-// docs/architecture.md "One magnetic step", 4: per-body forces and torques;
-// bodies held with RelaxOptions::kHeldKeepForce keep theirs.
-void compute_forces(const MagneticModel& model, MagneticState& state, const RelaxOptions& o,
-                    MagneticBackend& backend) {
-  std::vector<std::pair<Vec3, Vec3>> kept(o.held_bodies.size());
-  for (size_t b = 0; b < kept.size(); ++b) kept[b] = {state.force[b], state.torque[b]};
+// docs/architecture.md "One magnetic step", 4: per-body forces and torques.
+void compute_forces(const MagneticModel& model, MagneticState& state, MagneticBackend& backend) {
   backend.forces(model, state);
   add_coil_forces(model, state);
-  for (size_t b = 0; b < kept.size(); ++b)
-    if (o.held_bodies[b] == RelaxOptions::kHeldKeepForce) std::tie(state.force[b], state.torque[b]) = kept[b];
 }
 
 // docs/architecture.md "One magnetic step", 5: remember what was solved, for the skip check.
@@ -622,7 +616,7 @@ RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
   const std::vector<int> cells = solved_cells(model, state, options);
   const std::vector<Vec3> H_fixed = fixed_field(model, state, backend, cells);
   RelaxReport report = solve(model, state, options, backend, cells, H_fixed);
-  compute_forces(model, state, options, backend);
+  compute_forces(model, state, backend);
   record_step(state, options, report);
   if (!options.held_bodies.empty()) backend.set_held_bodies({});  // held for this step only
   return report;
@@ -631,7 +625,7 @@ RelaxReport magnetic_step(const MagneticModel& model, MagneticState& state,
 void magnetic_forces_at_held_magnetization(const MagneticModel& model, MagneticState& state,
                                            const RelaxOptions& options, MagneticBackend& backend) {
   place_cells_and_begin_step(model, state, options, backend);
-  compute_forces(model, state, options, backend);
+  compute_forces(model, state, backend);
   state.last_solve.valid = false;  // the held magnetization is not the solution at these poses
 }
 

@@ -143,7 +143,7 @@ std::unique_ptr<MagneticBackend> backend_for(const SceneDescription& scene, cons
   if (threads && *threads < 0) throw py::value_error("threads: expected 0 (all cores) or more, got " + std::to_string(*threads));
   try {
     // The "no CUDA device, using the CPU" notice is dropped: the result's backend says which ran.
-    return make_backend(backend.value_or(scene.solver.backend), threads.value_or(scene.solver.threads), nullptr,
+    return make_backend(backend ? backend_kind(*backend) : scene.solver.backend, threads.value_or(scene.solver.threads), nullptr,
                         cpu_only_feature(scene));
   } catch (const std::invalid_argument& e) {
     if (backend) throw py::value_error(std::string("backend: ") + e.what());

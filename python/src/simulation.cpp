@@ -152,33 +152,31 @@ class PySimulation {
     return copied_array<bool>(p);
   }
 
-  // One array per StepRecord field, one entry per rigid step.
+  // One array per StepReport field, one entry per rigid step.
   py::dict records() const {
-    const std::vector<StepRecord>& r = sim_.records();
+    const std::vector<StepReport>& r = sim_.records();
     auto column = [&](auto field) {
       using T = std::decay_t<decltype(r.front().*field)>;
       std::vector<T> v;
-      for (const StepRecord& s : r) v.push_back(s.*field);
+      for (const StepReport& s : r) v.push_back(s.*field);
       return v;
     };
     py::dict d;
-    d["time"] = double_array(column(&StepRecord::time));
-    d["magnetic_ms"] = double_array(column(&StepRecord::magnetic_ms));
-    d["rigid_ms"] = double_array(column(&StepRecord::rigid_ms));
-    d["wall_ms"] = double_array(column(&StepRecord::wall_ms));
-    d["substeps"] = copied_array<int>(column(&StepRecord::substeps));
-    d["substeps_wanted"] = copied_array<int>(column(&StepRecord::substeps_wanted));
-    d["iterations"] = copied_array<int>(column(&StepRecord::iterations));
-    d["llg_steps"] = copied_array<long>(column(&StepRecord::llg_steps));
-    d["newton_steps"] = copied_array<long>(column(&StepRecord::newton_steps));
-    d["relaxations"] = copied_array<int>(column(&StepRecord::relaxations));
-    d["skipped"] = copied_array<int>(column(&StepRecord::skipped));
-    d["converged"] = copied_array<bool>(column(&StepRecord::converged));
-    d["residual"] = double_array(column(&StepRecord::residual));
-    d["sleeping"] = copied_array<int>(column(&StepRecord::sleeping));
-    d["held"] = copied_array<int>(column(&StepRecord::held));
-    d["whole_step"] = copied_array<int>(column(&StepRecord::whole_step));
-    d["rezoned"] = copied_array<int>(column(&StepRecord::rezoned));
+    d["time"] = double_array(column(&StepReport::time));
+    d["magnetic_ms"] = double_array(column(&StepReport::magnetic_ms));
+    d["rigid_ms"] = double_array(column(&StepReport::rigid_ms));
+    d["wall_ms"] = double_array(column(&StepReport::wall_ms));
+    d["substeps"] = copied_array<int>(column(&StepReport::substeps));
+    d["substeps_wanted"] = copied_array<int>(column(&StepReport::substeps_wanted));
+    d["iterations"] = copied_array<int>(column(&StepReport::iterations));
+    d["llg_steps"] = copied_array<long>(column(&StepReport::llg_steps));
+    d["newton_steps"] = copied_array<long>(column(&StepReport::newton_steps));
+    d["relaxations"] = copied_array<int>(column(&StepReport::relaxations));
+    d["skipped"] = copied_array<int>(column(&StepReport::skipped));
+    d["converged"] = copied_array<bool>(column(&StepReport::converged));
+    d["residual"] = double_array(column(&StepReport::residual));
+    d["held"] = copied_array<int>(column(&StepReport::held));
+    d["rezoned"] = copied_array<int>(column(&StepReport::rezoned));
     return d;
   }
 

@@ -99,7 +99,7 @@ def test_state_arrays_shapes_and_units():
     r = sim.records
     assert set(r) == {"time", "magnetic_ms", "rigid_ms", "wall_ms", "substeps", "substeps_wanted", "iterations",
                       "llg_steps", "newton_steps", "relaxations", "skipped", "converged", "residual",
-                      "sleeping", "held", "whole_step", "rezoned"}
+                      "held", "rezoned"}
     assert all(len(v) == 3 for v in r.values())
     np.testing.assert_array_equal(r["time"], [0.0, sim.time_step, 2 * sim.time_step])
     assert r["substeps"].dtype.kind == "i" and r["converged"].dtype == np.bool_

@@ -105,7 +105,7 @@ TEST(SceneParser, InterfaceExample) {
   EXPECT_EQ(s.find_body("nothing"), -1);
   // Defaults of what the example leaves out.
   EXPECT_EQ(s.seed, 1u);
-  EXPECT_EQ(s.solver.backend, "auto");
+  EXPECT_EQ(s.solver.backend, BackendKind::automatic);
   EXPECT_EQ(s.solver.relax.scheme, RelaxScheme::two_level);
   EXPECT_TRUE(s.timeline.empty());
 }
@@ -159,7 +159,7 @@ TEST(SceneParser, AllSettings) {
   EXPECT_EQ(s.solver.relax.far_field_theta, 0.5);
   EXPECT_TRUE(s.solver.relax.skip_unchanged);
   EXPECT_FALSE(s.solver.relax.near_field);
-  EXPECT_EQ(s.solver.backend, "cpu");
+  EXPECT_EQ(s.solver.backend, BackendKind::cpu);
   EXPECT_EQ(s.solver.threads, 3);
   EXPECT_EQ(s.simulation.time_step, 0.001);
   EXPECT_EQ(s.simulation.duration, 1.5);

@@ -64,7 +64,7 @@ void run_to_end(Simulation& sim) {
   sim.finish();
   for (int b = 0; b < sim.world().body_count(); ++b) EXPECT_TRUE(sim.finite_state(b)) << b;
   int unconverged = 0;
-  for (const StepRecord& r : sim.records()) unconverged += r.converged ? 0 : 1;
+  for (const StepReport& r : sim.records()) unconverged += r.converged ? 0 : 1;
   EXPECT_EQ(unconverged, 0);
 }
 
@@ -264,7 +264,7 @@ TEST(CraneScene, HoldsMoreBallsAtFullThanReducedAndSomeWhenOff) {
   // the full crane 5.94, docs/benchmarks.md 4q).
   double iterations = 0.0;
   int steps = 0;
-  for (const StepRecord& r : sim.records())
+  for (const StepReport& r : sim.records())
     if (r.time >= 4.3) {
       iterations += r.iterations;
       ++steps;

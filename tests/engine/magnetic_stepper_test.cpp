@@ -161,21 +161,58 @@ TEST(MagneticStepper, OneSubstepIsThePlainLoop) {
   EXPECT_LT(plain.gap(), 0.0) << "touching after 0.3 s";
 }
 
-// magnetic_solve "step": one relaxation per rigid step, the other substeps
-// at the held magnetization; still rests on the magnet.
-TEST(MagneticStepper, OneRelaxationPerStep) {
+// MagneticSolve::moving: every substep relaxes, but a later substep holds
+// the magnetization of the bodies that neither need the substeps nor touch
+// one that does. A second iron ball resting on the ground 30 cm from the
+// magnet is held whenever the falling one takes substeps; the falling one
+// still comes to rest on the magnet and the resting one stays where it is.
+TEST(MagneticStepper, MovingSolveHoldsTheRestingBall) {
   EmbedWorld w(0.0);
+  dBodyID resting = dBodyCreate(w.world);
+  dMass mass;
+  dMassSetSphere(&mass, 7870, kRadius);
+  dBodySetMass(resting, &mass);
+  dBodySetPosition(resting, -0.3, 0, kRadius);
+  dGeomSetBody(dCreateSphere(w.space, kRadius), resting);
+  SoftMaterial iron;
+  iron.saturation = 1.7e6;
+  iron.susceptibility = 5000;
+  w.magnetics.attach(resting, Sphere{kRadius}, iron, 0.0, "resting");
   StepperSettings settings;
-  settings.magnetic_solve = MagneticSolve::step;
+  settings.magnetic_solve = MagneticSolve::moving;
   MagneticStepper stepper = w.stepper(settings);
-  bool split = false;
+  int later_substeps = 0, held = 0;
   for (int i = 0; i < 2000; ++i) {
     const StepReport& r = stepper.step(kStep);
-    ASSERT_EQ(r.relaxations, 1);
-    split = split || r.substeps > 1;
+    ASSERT_EQ(r.relaxations, r.substeps);
+    later_substeps += r.substeps - 1;
+    held += r.held;
   }
-  EXPECT_TRUE(split);
+  ASSERT_GT(later_substeps, 0) << "the fall never needed substeps";
+  EXPECT_GE(held, later_substeps) << "the resting ball in every later substep";
   EXPECT_NEAR(w.gap(), 0.0, kTouching);
+  EXPECT_NEAR(dBodyGetPosition(resting)[0], -0.3, 1e-4);
+}
+
+// A force that turns non-finite (here: the magnet's magnetization scaled to
+// NaN is refused, so a NaN velocity is given to the ball) ends the step at
+// the substep that made it, and the next step() throws naming the body,
+// before ODE's collision sees the NaN.
+TEST(MagneticStepper, ANonFiniteStateStopsTheStepAndTheNextThrows) {
+  EmbedWorld w(0.0);
+  MagneticStepper stepper = w.stepper();
+  for (int i = 0; i < 10; ++i) stepper.step(kStep);
+  dBodySetLinearVel(w.ball, std::numeric_limits<double>::quiet_NaN(), 0, 0);
+  const StepReport& r = stepper.step(kStep);
+  EXPECT_EQ(r.non_finite_body, 1);
+  EXPECT_EQ(stepper.non_finite_step(), 11);
+  try {
+    stepper.step(kStep);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("body 1 ('ball') has a non-finite state at step 11"), std::string::npos)
+        << e.what();
+  }
 }
 
 // The rule for one free steel ball of 5 mm radius and 4 g, at rest.

@@ -16,7 +16,8 @@ using test_support::body;
 using test_support::steel;
 
 OutcomeDescription outcome(const std::string& name, OutcomeDescription::Quantity q, std::vector<std::string> bodies,
-                           double time = -1.0, const std::string& statistic = "") {
+                           double time = -1.0,
+                           OutcomeDescription::Statistic statistic = OutcomeDescription::Statistic::none) {
   OutcomeDescription o;
   o.name = name;
   o.quantity = q;
@@ -46,9 +47,9 @@ TEST(Outcomes, EachQuantityAtATimeAtTheEndAndOverTheRun) {
   const double R = kMagnetRadius, r = kBallRadius, z0 = kStartHeight;
   SceneDescription s = ball_onto_magnet("outcomes");
   s.outcomes = {outcome("start_height", Q::height, {"ball"}, 0.0),
-                outcome("closest", Q::distance, {"ball", "magnet"}, -1.0, "min"),
-                outcome("farthest", Q::distance, {"ball", "magnet"}, -1.0, "max"),
-                outcome("fastest", Q::speed, {"ball"}, -1.0, "max"),
+                outcome("closest", Q::distance, {"ball", "magnet"}, -1.0, OutcomeDescription::Statistic::min),
+                outcome("farthest", Q::distance, {"ball", "magnet"}, -1.0, OutcomeDescription::Statistic::max),
+                outcome("fastest", Q::speed, {"ball"}, -1.0, OutcomeDescription::Statistic::max),
                 outcome("contacts", Q::contact_count, {"ball"}),
                 outcome("pull_z", Q::force, {"ball"}),
                 outcome("moment", Q::moment, {"ball"}),
@@ -85,11 +86,11 @@ TEST(Outcomes, EachQuantityAtATimeAtTheEndAndOverTheRun) {
 TEST(Outcomes, MeanFromAStartTime) {
   using Q = OutcomeDescription::Quantity;
   SceneDescription s = ball_onto_magnet("outcomes_mean");
-  s.outcomes = {outcome("height_end", Q::height, {"ball"}), outcome("height_mean", Q::height, {"ball"}, -1.0, "mean"),
-                outcome("speed_mean", Q::speed, {"ball"}, -1.0, "mean"),
-                outcome("speed_max", Q::speed, {"ball"}, -1.0, "max"),
-                outcome("speed_min", Q::speed, {"ball"}, -1.0, "min"),
-                outcome("late", Q::height, {"ball"}, -1.0, "mean")};
+  s.outcomes = {outcome("height_end", Q::height, {"ball"}), outcome("height_mean", Q::height, {"ball"}, -1.0, OutcomeDescription::Statistic::mean),
+                outcome("speed_mean", Q::speed, {"ball"}, -1.0, OutcomeDescription::Statistic::mean),
+                outcome("speed_max", Q::speed, {"ball"}, -1.0, OutcomeDescription::Statistic::max),
+                outcome("speed_min", Q::speed, {"ball"}, -1.0, OutcomeDescription::Statistic::min),
+                outcome("late", Q::height, {"ball"}, -1.0, OutcomeDescription::Statistic::mean)};
   s.outcomes[1].from = 0.5;
   s.outcomes[5].from = 99.0;
   Simulation sim(s);

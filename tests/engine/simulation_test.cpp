@@ -72,32 +72,6 @@ TEST_P(BallOntoMagnet, ComesToRestTouchingItWithoutTunnellingOrNaN) {
 
 INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnet, ::testing::Values(0.001, 0.004, 0.010));
 
-// simulation.magnetic_solve "step": one relaxation per rigid step, the later
-// substeps recomputing forces at the new positions with the magnetization
-// held. The same ball comes to rest the same way, and no step relaxes twice
-// although the approach takes several substeps.
-class BallOntoMagnetOneSolvePerStep : public ::testing::TestWithParam<double> {};
-
-TEST_P(BallOntoMagnetOneSolvePerStep, ComesToRestTouchingIt) {
-  const double dt = GetParam();
-  SceneDescription scene = ball_onto_magnet(dt);
-  scene.simulation.magnetic_solve = "step";
-  Simulation sim(scene);
-  double closest = 1.0;
-  int most_substeps = 0;
-  while (sim.time() < 1.5) {
-    sim.step();
-    for (int b = 0; b < 2; ++b) ASSERT_TRUE(sim.finite_state(b)) << "t=" << sim.time();
-    closest = std::min(closest, norm(sim.world().pose(1).position - Vec3{0, 0, 0.008}));
-    ASSERT_EQ(sim.records().back().relaxations, 1) << "t=" << sim.time();
-    most_substeps = std::max(most_substeps, sim.records().back().substeps);
-  }
-  EXPECT_GT(most_substeps, 1) << "dt=" << dt << ": the case never needed substeps";
-  expect_resting_on_the_pole(sim, closest, dt);
-}
-
-INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnetOneSolvePerStep, ::testing::Values(0.001, 0.004, 0.010));
-
 // simulation.magnetic_solve "moving": every substep relaxes, but a later
 // substep holds the magnetization of the bodies that neither need the
 // substeps nor touch one that does (docs/simulation.md "Substeps"). A second
@@ -109,7 +83,7 @@ TEST_P(BallOntoMagnetMovingSolve, ComesToRestTouchingItWhileTheRestingBallIsHeld
   const double dt = GetParam();
   SceneDescription scene = ball_onto_magnet(dt);
   scene.bodies.push_back(body("resting", Sphere{0.005}, "steel", {0.1, 0.0, 0.005}));
-  scene.simulation.magnetic_solve = "moving";
+  scene.simulation.magnetic_solve = MagneticSolve::moving;
   Simulation sim(scene);
   double closest = 1.0;
   int later_substeps = 0, held = 0;
@@ -117,7 +91,7 @@ TEST_P(BallOntoMagnetMovingSolve, ComesToRestTouchingItWhileTheRestingBallIsHeld
     sim.step();
     for (int b = 0; b < 3; ++b) ASSERT_TRUE(sim.finite_state(b)) << "t=" << sim.time();
     closest = std::min(closest, norm(sim.world().pose(1).position - Vec3{0, 0, 0.008}));
-    const StepRecord& r = sim.records().back();
+    const StepReport& r = sim.records().back();
     ASSERT_EQ(r.relaxations, r.substeps) << "t=" << sim.time();
     later_substeps += r.substeps - 1;
     held += r.held;
@@ -132,102 +106,6 @@ TEST_P(BallOntoMagnetMovingSolve, ComesToRestTouchingItWhileTheRestingBallIsHeld
 }
 
 INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnetMovingSolve, ::testing::Values(0.001, 0.004, 0.010));
-
-// simulation.rigid_substeps "moving": the bodies that neither need the
-// substeps nor touch one that does take the rigid step whole and ride through
-// the others' substeps (docs/simulation.md "Substeps"). Beside the falling
-// ball, a wooden (inert) ball falls freely 15 cm away: it takes every step
-// whole, so its height after N steps is the closed form of ODE's
-// semi-implicit Euler step at dt, z0 - g dt^2 N (N + 1) / 2, whatever the
-// other ball's substeps; the falling ball comes to rest on the pole as before,
-// and a steel ball resting on a second one stays on it.
-class BallOntoMagnetRigidMoving : public ::testing::TestWithParam<double> {};
-
-TEST_P(BallOntoMagnetRigidMoving, TheFreeBallStepsWholeAndTheFallingBallComesToRest) {
-  const double dt = GetParam();
-  SceneDescription scene = ball_onto_magnet(dt);
-  scene.materials["wood"] = InertMaterial{};
-  const double z0 = 0.3;
-  scene.bodies.push_back(body("free", Sphere{0.005}, "wood", {0.15, 0.0, z0}, false, 700.0));
-  scene.bodies.push_back(body("below", Sphere{0.005}, "steel", {-0.1, 0.0, 0.005}));
-  scene.bodies.push_back(body("above", Sphere{0.005}, "steel", {-0.1, 0.0, 0.015}));
-  scene.simulation.magnetic_solve = "moving";
-  scene.simulation.rigid_substeps = "moving";
-  Simulation sim(scene);
-  const double g = norm(scene.gravity);
-  double closest = 1.0;
-  int split_steps = 0;
-  while (sim.time() < 1.5) {
-    sim.step();
-    for (int b = 0; b < 5; ++b) ASSERT_TRUE(sim.finite_state(b)) << "t=" << sim.time();
-    closest = std::min(closest, norm(sim.world().pose(1).position - Vec3{0, 0, 0.008}));
-    const StepRecord& r = sim.records().back();
-    if (r.substeps > 1) {
-      ++split_steps;
-      EXPECT_GE(r.whole_step, 1) << "t=" << sim.time();  // the free ball at least
-    }
-    if (sim.time() <= 0.2 + 1e-9) {  // before it comes near the ground (clearance: no substeps of its own)
-      const double n = static_cast<double>(sim.steps());
-      EXPECT_NEAR(sim.world().pose(2).position.z, z0 - 0.5 * g * dt * dt * n * (n + 1.0), 1e-9)
-          << "t=" << sim.time();
-    }
-  }
-  ASSERT_GT(split_steps, 0) << "dt=" << dt << ": the case never needed substeps";
-  expect_resting_on_the_pole(sim, closest, dt);
-  EXPECT_NEAR(sim.world().pose(4).position.z, 0.015, 2e-4) << "the upper ball stays on the lower one";
-  EXPECT_NEAR(sim.world().pose(4).position.x, -0.1, 2e-4);
-}
-
-INSTANTIATE_TEST_SUITE_P(TimeSteps, BallOntoMagnetRigidMoving, ::testing::Values(0.001, 0.004, 0.010));
-
-// A rider is not a wall: a wooden ball at 1 m/s (4 mm per 4 ms step, so it
-// takes substeps) runs head-on into an equal one at rest, which takes its
-// steps whole and rides until the impact (no gravity, no ground). With it
-// dynamic again from the substep of the impact, the two share the momentum
-// as a collision with restitution e does: v_front = v0 (1 + e) / 2, v_back =
-// v0 (1 - e) / 2 (e = the contact's restitution, 0.1), and the total m v0 is
-// kept to ODE's rounding. (A wall would have stopped the first ball and left
-// the second at rest: half the momentum lost.)
-TEST(BallOntoMagnetRigidMoving, ARiderThatABodyRunsIntoTakesItsShareOfTheMomentum) {
-  SceneDescription scene = weightless_scene("head_on");
-  scene.materials["wood"] = InertMaterial{};
-  scene.bodies.push_back(body("moving", Sphere{0.005}, "wood", {0.0, 0.0, 0.0}, false, 700.0));
-  scene.bodies.back().velocity = {1.0, 0.0, 0.0};
-  scene.bodies.push_back(body("resting", Sphere{0.005}, "wood", {0.0325, 0.0, 0.0}, false, 700.0));
-  scene.simulation.time_step = 0.004;
-  scene.simulation.rigid_substeps = "moving";
-  Simulation sim(scene);
-  const double v0 = 1.0, e = scene.simulation.contact.restitution;
-  int rode = 0;
-  while (sim.time() < 0.06) {
-    sim.step();
-    rode += sim.records().back().whole_step;
-  }
-  ASSERT_GT(rode, 0) << "the resting ball never rode";
-  const double v_back = sim.world().velocity(0).x, v_front = sim.world().velocity(1).x;
-  EXPECT_NEAR(v_back + v_front, v0, 1e-9) << "momentum (per unit mass)";
-  EXPECT_NEAR(v_front, 0.5 * v0 * (1.0 + e), 0.02 * v0);
-  EXPECT_NEAR(v_back, 0.5 * v0 * (1.0 - e), 0.02 * v0);
-}
-
-// With the default ("all") the free ball takes the substeps too: its height
-// leaves the closed form at dt (the test above tells the two apart).
-TEST(BallOntoMagnetRigidMoving, ByDefaultEveryBodyTakesTheSubsteps) {
-  const double dt = 0.004;
-  SceneDescription scene = ball_onto_magnet(dt);
-  scene.materials["wood"] = InertMaterial{};
-  scene.bodies.push_back(body("free", Sphere{0.005}, "wood", {0.15, 0.0, 0.3}, false, 700.0));
-  Simulation sim(scene);
-  int split_steps = 0;
-  while (sim.time() < 0.2) {
-    sim.step();
-    split_steps += sim.records().back().substeps > 1;
-    EXPECT_EQ(sim.records().back().whole_step, 0);
-  }
-  ASSERT_GT(split_steps, 0);
-  const double n = static_cast<double>(sim.steps());
-  EXPECT_GT(std::fabs(sim.world().pose(2).position.z - (0.3 - 0.5 * 9.81 * dt * dt * n * (n + 1.0))), 1e-6);
-}
 
 // With the default ("substep") every substep relaxes.
 TEST(BallOntoMagnet, EverySubstepRelaxesByDefault) {
@@ -544,7 +422,7 @@ TEST(Simulation, ContactZonesFollowASlidingBall) {
   };
   auto rezoned = [](const Simulation& sim) {
     int total = 0;
-    for (const StepRecord& r : sim.records()) total += r.rezoned;
+    for (const StepReport& r : sim.records()) total += r.rezoned;
     return total;
   };
   Simulation sliding(scene(3.0, true));
@@ -599,12 +477,10 @@ TEST(Simulation, ContactZonesFollowASlidingBall) {
 // R and its collision skin, 2% of R: docs/simulation.md) at
 // a = -rho g R' / (2/5 R^2 + R'^2) (m a = -f, I a / R' = f R' - rho m g).
 // Each coefficient acts on its own axis only, and a zero one leaves that
-// motion free. With rolling_axes "rolling" (one row about the axis the ball
-// rolls about) the same closed forms hold along any direction of rolling.
+// motion free.
 struct ResistanceCase {
-  const char* solver;
+  ContactSolver solver;
   double rolling, spinning;  // m; spinning < 0: the default (rolling_friction)
-  const char* axes = "both";  // ContactSettings::rolling_axes
 };
 
 class ContactResistance : public ::testing::TestWithParam<ResistanceCase> {
@@ -623,7 +499,6 @@ class ContactResistance : public ::testing::TestWithParam<ResistanceCase> {
     s.simulation.contact_solver = c.solver;
     s.simulation.contact.rolling_friction = c.rolling;
     s.simulation.contact.spinning_friction = c.spinning;
-    s.simulation.contact.rolling_axes = c.axes;
     Simulation sim(s);
     while (sim.time() < t - 1e-9) sim.step();
     return {sim.world().velocity(0), sim.world().angular_velocity(0)};
@@ -665,15 +540,14 @@ TEST_P(ContactResistance, RollingBallDeceleratesAtTheClosedFormRateOfItsCoeffici
 }
 
 // Along the diagonal of the contact's two friction directions (x and y for
-// a ball on the ground): with "both", ODE bounds each rolling row by rho N on
-// its own (a pyramid), so the ball is held back by sqrt(2) times the closed
-// form; with "rolling", by the closed form, as along x or y.
+// a ball on the ground): ODE bounds each rolling row by rho N on its own (a
+// pyramid), so the ball is held back by sqrt(2) times the closed form.
 TEST_P(ContactResistance, RollingAlongTheDiagonalOfTheFrictionDirections) {
   const ResistanceCase c = GetParam();
   if (c.rolling == 0.0) GTEST_SKIP() << "no rolling resistance";
   const double v0 = 0.2, t = 0.5;
   const double deceleration = c.rolling * kG * kRolling / (0.4 * kR * kR + kRolling * kRolling);
-  const double held_back = std::string(c.axes) == "rolling" ? 1.0 : std::sqrt(2.0);
+  const double held_back = std::sqrt(2.0);
   const double u = v0 / std::sqrt(2.0);
   const Vec3 v = run(c, {u, u, 0}, {-u / kRolling, u / kRolling, 0}, t).first;
   const double speed_lost = v0 - std::hypot(v.x, v.y);
@@ -683,15 +557,14 @@ TEST_P(ContactResistance, RollingAlongTheDiagonalOfTheFrictionDirections) {
 
 INSTANTIATE_TEST_SUITE_P(
     Coefficients, ContactResistance,
-    ::testing::Values(ResistanceCase{"quick", 1e-5, -1.0}, ResistanceCase{"quick", 1e-4, 0.0},
-                      ResistanceCase{"quick", 0.0, 1e-5}, ResistanceCase{"quick", 0.0, 0.0},
-                      ResistanceCase{"quick", 1e-4, 5e-6}, ResistanceCase{"exact", 1e-5, -1.0},
-                      ResistanceCase{"exact", 1e-4, 0.0}, ResistanceCase{"exact", 0.0, 1e-5},
-                      ResistanceCase{"quick", 1e-5, -1.0, "rolling"},
-                      ResistanceCase{"quick", 1e-4, 0.0, "rolling"},
-                      ResistanceCase{"quick", 1e-4, 5e-6, "rolling"},
-                      ResistanceCase{"exact", 1e-4, 0.0, "rolling"},
-                      ResistanceCase{"exact", 1e-5, -1.0, "rolling"}));
+    ::testing::Values(ResistanceCase{ContactSolver::quick, 1e-5, -1.0},
+                      ResistanceCase{ContactSolver::quick, 1e-4, 0.0},
+                      ResistanceCase{ContactSolver::quick, 0.0, 1e-5},
+                      ResistanceCase{ContactSolver::quick, 0.0, 0.0},
+                      ResistanceCase{ContactSolver::quick, 1e-4, 5e-6},
+                      ResistanceCase{ContactSolver::exact, 1e-5, -1.0},
+                      ResistanceCase{ContactSolver::exact, 1e-4, 0.0},
+                      ResistanceCase{ContactSolver::exact, 0.0, 1e-5}));
 
 // The rows each contact asks ODE for: none of rolling or spinning
 // resistance when both coefficients are 0 (ODE adds three with
@@ -727,56 +600,6 @@ TEST(ContactSurface, AsksForTheResistanceRowsOfNonzeroCoefficientsOnly) {
   EXPECT_LT(s.rho, 0.0);
   EXPECT_LT(s.rho2, 0.0);
   EXPECT_EQ(s.rhoN, 2e-5);
-}
-
-// align_rolling_row (rolling_axes "rolling"): a contact whose bodies roll
-// relative to each other keeps one rolling row, about their relative angular
-// velocity's part in the contact plane (fdir1), and its spinning row as the
-// surface had it; at rest, or spinning about the normal only, it keeps the
-// surface's rows; a surface without rolling resistance is left alone.
-TEST(ContactSurface, OneRollingRowAboutTheAxisTheBodiesRollAbout) {
-  ContactSettings c;
-  c.rolling_friction = 1e-5;
-  c.spinning_friction = 0.0;
-  dContact contact{};
-  contact.surface = contact_surface(c);
-  contact.geom.normal[2] = 1.0;
-  dContact aligned = contact;
-  align_rolling_row(aligned, {0.0, -3.0, 7.0});  // rolls about -y, spins about z
-  EXPECT_NE(aligned.surface.mode & dContactFDir1, 0);
-  EXPECT_NE(aligned.surface.mode & dContactAxisDep, 0);
-  EXPECT_EQ(aligned.surface.mu2, aligned.surface.mu);
-  EXPECT_EQ(aligned.fdir1[0], 0.0);
-  EXPECT_EQ(aligned.fdir1[1], -1.0);
-  EXPECT_EQ(aligned.fdir1[2], 0.0);
-  EXPECT_EQ(aligned.surface.rho, 1e-5);
-  EXPECT_LT(aligned.surface.rho2, 0.0) << "no row about n x fdir1";
-  EXPECT_LT(aligned.surface.rhoN, 0.0) << "no spinning row, as the surface";
-
-  for (const Vec3& omega : {Vec3{0.0, 0.0, 0.0}, Vec3{0.0, 0.0, 5.0}, Vec3{1e-10, 0.0, 0.0}}) {
-    dContact kept = contact;
-    align_rolling_row(kept, omega);
-    EXPECT_EQ(kept.surface.mode, contact.surface.mode) << "not rolling: both rows";
-    EXPECT_EQ(kept.surface.rho2, contact.surface.rho2);
-  }
-
-  c.spinning_friction = -1.0;  // equal coefficients: no dContactAxisDep
-  contact.surface = contact_surface(c);
-  aligned = contact;
-  align_rolling_row(aligned, {2.0, 2.0, 0.0});
-  EXPECT_NEAR(aligned.fdir1[0], std::sqrt(0.5), 1e-15);
-  EXPECT_NEAR(aligned.fdir1[1], std::sqrt(0.5), 1e-15);
-  EXPECT_EQ(aligned.surface.rho, 1e-5);
-  EXPECT_LT(aligned.surface.rho2, 0.0);
-  EXPECT_EQ(aligned.surface.rhoN, 1e-5) << "the spinning row kept";
-
-  c.rolling_friction = 0.0;
-  c.spinning_friction = 2e-5;
-  contact.surface = contact_surface(c);
-  aligned = contact;
-  align_rolling_row(aligned, {2.0, 0.0, 0.0});
-  EXPECT_EQ(aligned.surface.mode, contact.surface.mode)
-      << "no rolling resistance: nothing to align";
 }
 
 }  // namespace

@@ -313,7 +313,7 @@ TEST(CudaBackend, BackendInUseIsCuda) {
   EXPECT_EQ(cuda->name(), "cuda");
   for (const char* choice : {"auto", "cuda"}) {
     std::string notice;
-    const std::unique_ptr<MagneticBackend> chosen = make_backend(choice, 2, &notice);
+    const std::unique_ptr<MagneticBackend> chosen = make_backend(backend_kind(choice), 2, &notice);
     ASSERT_TRUE(chosen) << choice;
     EXPECT_EQ(chosen->name(), "cuda") << choice << ": " << notice;
     EXPECT_TRUE(notice.empty()) << choice << ": " << notice;

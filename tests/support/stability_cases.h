@@ -35,7 +35,7 @@ struct CaseResult {
   double time_step = 0.0, duration = 0.0;
   long steps = 0;
   int max_substeps = 0;
-  int max_substeps_wanted = 0;  // before the cap max_substeps (StepRecord::substeps_wanted)
+  int max_substeps_wanted = 0;  // before the cap max_substeps (StepReport::substeps_wanted)
   long iterations = 0;          // outer relaxation iterations, all steps and substeps
   int max_step_iterations = 0;
   bool converged = true;  // every relaxation converged
@@ -352,7 +352,7 @@ inline CaseResult run_case(const std::string& name, const SceneDescription& scen
   sim.world().add_accumulator(&sampler);
   while (sim.time() + 0.5 * scene.simulation.time_step < options.duration) {
     sim.step();
-    const StepRecord& rec = sim.records().back();
+    const StepReport& rec = sim.records().back();
     r.max_substeps = std::max(r.max_substeps, rec.substeps);
     r.max_substeps_wanted = std::max(r.max_substeps_wanted, rec.substeps_wanted);
     r.iterations += rec.iterations;
@@ -442,7 +442,7 @@ inline SceneDescription overlapping_magnets() {
   // and adds energy, in whichever build meets the degenerate contact set;
   // QuickStep has no pivoting to fail (docs/hard-cases.md "Deep box-box
   // overlaps").
-  s.simulation.contact_solver = "quick";
+  s.simulation.contact_solver = ContactSolver::quick;
   return s;
 }
 
