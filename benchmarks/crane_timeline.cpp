@@ -25,8 +25,10 @@
 #include <vector>
 
 #include "benchmarks/bench_common.h"
-#include "engine/scene/scene.h"
-#include "engine/simulation/simulation.h"
+#include "odemag/scene.h"
+#include "odemag/simulation.h"
+#include "engine/simulation/rigid_world.h"
+#include "magnetics/model/backend.h"
 
 using namespace odemag;
 

@@ -28,8 +28,9 @@
 #include <vector>
 
 #include "benchmarks/bench_common.h"
-#include "engine/scene/scene.h"
-#include "engine/simulation/simulation.h"
+#include "odemag/scene.h"
+#include "odemag/simulation.h"
+#include "engine/simulation/rigid_world.h"
 
 using namespace odemag;
 

@@ -57,8 +57,8 @@
 
 #include "benchmarks/bench_common.h"
 #include "benchmarks/timed_backend.h"
-#include "engine/scene/scene.h"
-#include "engine/simulation/simulation.h"
+#include "odemag/scene.h"
+#include "odemag/simulation.h"
 #include "magnetics/model/backend.h"
 #include "magnetics/cells/demag_tensor.h"
 #include "magnetics/relax/relax.h"

@@ -17,7 +17,7 @@
 #include <memory>
 
 #include "engine/simulation/frame_writer.h"
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 #include "magnetics/model/backend.h"
 #include "odemag/vec3.h"
 

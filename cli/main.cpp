@@ -13,7 +13,7 @@
 #ifdef ODEMAG_WITH_RENDERER
 #include "render/scene_view.h"
 #endif
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 
 namespace {
 

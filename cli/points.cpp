@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "cli/cli.h"
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 
 namespace odemag::cli {
 

@@ -20,7 +20,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
+#include "engine/simulation/rigid_world.h"
 
 extern char** environ;
 

@@ -12,9 +12,11 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
-#include "engine/simulation/solve.h"
-#include "engine/scene/scene.h"
+#include "odemag/solve.h"
+#include "odemag/scene.h"
 #include "magnetics/relax/relax.h"
+#include "engine/simulation/magnetic_system.h"
+#include "gpu/backend_choice.h"
 
 namespace odemag::cli {
 

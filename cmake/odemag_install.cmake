@@ -2,19 +2,15 @@
 # (docs/embedding.md). Included from the top-level CMakeLists.txt after the
 # targets are defined.
 #
-# Installed: the libraries odemag::magnetics, odemag::gpu (the CUDA backend or
-# its stub), odemag::ode (the embedding library: MagneticForces and the force
-# accumulators, magnetics + ODE only), odemag::scene (scene files),
-# odemag::engine (the simulation) and the umbrella odemag::odemag; the public
-# headers (ODEMAG_PUBLIC_HEADERS below: the embedding, scene-loading and
-# simulation headers and the magnetics headers they include) under
-# include/odemag/ with their source paths, so that
-# #include "engine/embedding/magnetic_forces.h" works as in the source tree; and
-# the odemag program. Everything else is private, in particular the SIMD
-# kernels (magnetics/kernels/simd.h, pair_sums.h), whose intrinsics are chosen by the
-# compiler flags. odemag_warnings and odemag_tuning (-march=native) are
-# build-only: the libraries link them as $<BUILD_INTERFACE:...>, so consumers
-# compile with their own flags.
+# Installed: the libraries odemag::magnetics, odemag::ode (the embedding
+# library: MagneticForces and the step loop; magnetics + ODE only),
+# odemag::gpu (the CUDA backend or its stub, and MagneticForces' constructor
+# by backend kind), odemag::scene (scene files), odemag::engine (the
+# simulation) and the umbrella odemag::odemag; the public API, the headers
+# of include/odemag/ (#include <odemag/odemag.h>); and the odemag program.
+# Everything else is private. odemag_warnings and odemag_tuning
+# (-march=native) are build-only: the libraries link them as
+# $<BUILD_INTERFACE:...>, so consumers compile with their own flags.
 include(CMakePackageConfigHelpers)
 
 set(ODEMAG_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/odemag)
@@ -30,26 +26,14 @@ install(TARGETS odemag_magnetics odemag_gpu odemag_ode odemag_scene odemag_engin
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-# The include directory, include/odemag, comes with odemag::magnetics
-# (INSTALL_INTERFACE in magnetics/CMakeLists.txt), which all of them link.
+# The include directory comes with odemag::magnetics (INSTALL_INTERFACE in
+# magnetics/CMakeLists.txt), which all of them link.
 install(TARGETS odemag RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 
-# The public API: three entry headers and what they include (closed under
-# #include; tests/install/install_test.cmake checks that).
-set(ODEMAG_PUBLIC_HEADERS
-  engine/embedding/magnetic_forces.h engine/embedding/force_accumulator.h       # embedding
-  engine/embedding/magnetic_stepper.h engine/embedding/substeps.h engine/embedding/exact_step.h
-  engine/scene/scene.h                                              # scene loading
-  engine/simulation/simulation.h engine/simulation/rigid_world.h engine/simulation/frame_writer.h
-  engine/simulation/magnetic_system.h engine/simulation/outcomes.h engine/simulation/solve.h engine/simulation/winding_solids.h  # simulation
-  gpu/cuda_backend.h
-  magnetics/model/backend.h magnetics/cells/cells.h include/odemag/constants.h magnetics/cells/demag_tensor.h
-  magnetics/materials/bh_curve.h magnetics/model/body_response.h magnetics/sources/coil.h magnetics/kernels/hd.h magnetics/kernels/llg.h include/odemag/material.h magnetics/model/model.h magnetics/relax/relax.h
-  magnetics/kernels/rng.h include/odemag/shape.h magnetics/kernels/small_eigen.h magnetics/model/state.h include/odemag/vec3.h)
-foreach(header IN LISTS ODEMAG_PUBLIC_HEADERS)
-  get_filename_component(dir ${header} DIRECTORY)
-  install(FILES ${PROJECT_SOURCE_DIR}/${header} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/odemag/${dir})
-endforeach()
+# The public API: include/odemag/, closed under #include
+# (tests/install/install_test.cmake checks that).
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/odemag DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+        FILES_MATCHING PATTERN "*.h")
 
 install(EXPORT odemagTargets
   NAMESPACE odemag::

@@ -10,8 +10,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "engine/embedding/magnetic_forces.h"
-#include "engine/embedding/magnetic_stepper.h"
+#include <odemag/odemag.h>
 
 static dWorldID world;
 static dJointGroupID contacts;

@@ -11,6 +11,7 @@
 #include "render/png_writer.h"
 #include "magnetics/relax/relax.h"
 #include "odemag/shape.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag {
 

@@ -9,7 +9,7 @@
 
 #include "render/renderer.h"
 #include "engine/simulation/frame_writer.h"
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
 
 namespace odemag {
 

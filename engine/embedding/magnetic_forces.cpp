@@ -1,4 +1,10 @@
-#include "engine/embedding/magnetic_forces.h"
+#include "odemag/magnetic_forces.h"
+
+#include "engine/embedding/saved_state.h"
+#include "magnetics/model/backend.h"
+#include "magnetics/model/model.h"
+#include "magnetics/model/state.h"
+#include "magnetics/relax/relax.h"
 
 #include <cmath>
 #include <sstream>
@@ -31,6 +37,22 @@ std::string format(const Mat3& m) {
 
 }  // namespace
 
+SavedMagneticState::SavedMagneticState() : data_(std::make_unique<Data>()) {}
+SavedMagneticState::~SavedMagneticState() = default;
+SavedMagneticState::SavedMagneticState(const SavedMagneticState& other)
+    : data_(std::make_unique<Data>(*other.data_)) {}
+SavedMagneticState& SavedMagneticState::operator=(const SavedMagneticState& other) {
+  if (this != &other) *data_ = *other.data_;
+  return *this;
+}
+SavedMagneticState::SavedMagneticState(SavedMagneticState&& other) noexcept
+    : data_(std::exchange(other.data_, std::make_unique<Data>())) {}
+SavedMagneticState& SavedMagneticState::operator=(SavedMagneticState&& other) noexcept {
+  std::swap(data_, other.data_);
+  return *this;
+}
+const RelaxReport& SavedMagneticState::report() const { return data_->report; }
+
 BodyPose ode_pose(dBodyID body) {
   BodyPose pose;
   const dReal* p = dBodyGetPosition(body);
@@ -43,16 +65,23 @@ BodyPose ode_pose(dBodyID body) {
 
 MagneticForces::MagneticForces(const RelaxOptions& options, std::unique_ptr<MagneticBackend> backend,
                                uint64_t seed, IntraBodyTensor intra_tensor)
-    : model_(intra_tensor), backend_(backend ? std::move(backend) : make_cpu_backend()), options_(options) {
-  state_ = make_state(model_, seed);
+    : model_(std::make_unique<MagneticModel>(intra_tensor)),
+      state_(std::make_unique<MagneticState>()),
+      backend_(backend ? std::move(backend) : make_cpu_backend()),
+      options_(options) {
+  *state_ = make_state(*model_, seed);
 }
+
+MagneticForces::MagneticForces(const RelaxOptions& options, int threads, uint64_t seed,
+                               IntraBodyTensor intra_tensor)
+    : MagneticForces(options, make_cpu_backend(threads), seed, intra_tensor) {}
 
 MagneticForces::MagneticForces(MagneticModel model, MagneticState state,
                                const RelaxOptions& options,
                                std::unique_ptr<MagneticBackend> backend)
-    : model_(std::move(model)),
-      state_(std::move(state)),
-      bodies_(static_cast<size_t>(model_.body_count()), nullptr),
+    : model_(std::make_unique<MagneticModel>(std::move(model))),
+      state_(std::make_unique<MagneticState>(std::move(state))),
+      bodies_(static_cast<size_t>(model_->body_count()), nullptr),
       backend_(backend ? std::move(backend) : make_cpu_backend()),
       options_(options),
       reference_force_(bodies_.size()),
@@ -60,36 +89,50 @@ MagneticForces::MagneticForces(MagneticModel model, MagneticState state,
       reference_known_(bodies_.size(), 0),
       refinements_(bodies_.size(), 0) {}
 
+MagneticForces::~MagneticForces() = default;
+
+Vec3 MagneticForces::external_field() const { return state_->external_field; }
+void MagneticForces::set_active(int index, bool active) {
+  state_->active[body_index(index, "set_active")] = active ? 1 : 0;
+}
+bool MagneticForces::active(int index) const { return state_->active[body_index(index, "active")] != 0; }
+double MagneticForces::magnetization_scale(int index) const {
+  return state_->magnetization_scale[body_index(index, "magnetization_scale")];
+}
+int MagneticForces::body_count() const { return model_->body_count(); }
+Vec3 MagneticForces::force(int index) const { return state_->force[body_index(index, "force")]; }
+Vec3 MagneticForces::torque(int index) const { return state_->torque[body_index(index, "torque")]; }
+
 int MagneticForces::body_index(int index, const char* call) const {
-  if (index < 0 || index >= model_.body_count())
+  if (index < 0 || index >= model_->body_count())
     throw std::out_of_range(std::string("MagneticForces::") + call + ": no magnetic body " + std::to_string(index) +
-                            " (" + std::to_string(model_.body_count()) + " attached)");
+                            " (" + std::to_string(model_->body_count()) + " attached)");
   return index;
 }
 
 void MagneticForces::bind(int index, dBodyID body) {
   bodies_[body_index(index, "bind")] = body;
   reference_known_[index] = 0;
-  if (body) state_.pose[index] = ode_pose(body);
+  if (body) state_->pose[index] = ode_pose(body);
 }
 
 void MagneticForces::refine_body(int index, const std::vector<RefinedZone>& zones) {
-  const MagneticBody old_body = model_.refine_body(body_index(index, "refine_body"), zones);
-  transfer_refined_state(model_, index, old_body, state_);
+  const MagneticBody old_body = model_->refine_body(body_index(index, "refine_body"), zones);
+  transfer_refined_state(*model_, index, old_body, *state_);
   ++refinements_[index];
 }
 
 int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& material,
                            double cell_size, const std::string& name) {
-  const int index = model_.add_body(name.empty() ? "body" + std::to_string(model_.body_count()) : name,
+  const int index = model_->add_body(name.empty() ? "body" + std::to_string(model_->body_count()) : name,
                                     shape, material, cell_size);
-  extend_state(model_, state_);
+  extend_state(*model_, *state_);
   bodies_.push_back(body);
   reference_force_.emplace_back();
   reference_torque_.emplace_back();
   reference_known_.push_back(0);
   refinements_.push_back(0);
-  if (body) state_.pose[index] = ode_pose(body);
+  if (body) state_->pose[index] = ode_pose(body);
   return index;
 }
 
@@ -121,36 +164,38 @@ void count_cells(const MagneticModel& model, std::vector<int>& cells, std::vecto
 }  // namespace
 
 SavedMagneticState MagneticForces::save_state() const {
-  SavedMagneticState saved;
-  saved.state = state_;
+  SavedMagneticState result;
+  SavedMagneticState::Data& saved = result.data();
+  saved.state = *state_;
   saved.report = report_;
-  count_cells(model_, saved.body_cells, saved.body_moments);
+  count_cells(*model_, saved.body_cells, saved.body_moments);
   saved.body_refinements = refinements_;
-  return saved;
+  return result;
 }
 
-void MagneticForces::restore_state(const SavedMagneticState& saved) {
+void MagneticForces::restore_state(const SavedMagneticState& saved_state) {
+  const SavedMagneticState::Data& saved = saved_state.data();
   const std::string where = "MagneticForces::restore_state: ";
   std::vector<int> cells, moments;
-  count_cells(model_, cells, moments);
+  count_cells(*model_, cells, moments);
   if (saved.body_cells.size() != cells.size() || saved.body_moments.size() != moments.size())
     throw std::invalid_argument(where + "the state was saved from " + std::to_string(saved.body_cells.size()) +
                                 " bodies, these magnetics have " + std::to_string(cells.size()));
   for (size_t b = 0; b < cells.size(); ++b)
     if (saved.body_cells[b] != cells[b] || saved.body_moments[b] != moments[b])
       throw std::invalid_argument(where + "body " + std::to_string(b) + " \"" +
-                                  model_.body(static_cast<int>(b)).name + "\" has " + std::to_string(cells[b]) +
+                                  model_->body(static_cast<int>(b)).name + "\" has " + std::to_string(cells[b]) +
                                   " cells and " + std::to_string(moments[b]) + " moments, the saved state " +
                                   std::to_string(saved.body_cells[b]) + " and " + std::to_string(saved.body_moments[b]));
   for (size_t b = 0; b < cells.size() && saved.body_refinements.size() == cells.size(); ++b)
     if (saved.body_refinements[b] != refinements_[b])
       throw std::invalid_argument(
-          where + "body " + std::to_string(b) + " \"" + model_.body(static_cast<int>(b)).name +
+          where + "body " + std::to_string(b) + " \"" + model_->body(static_cast<int>(b)).name +
           "\" got new refined zones (refine_body) since the state was saved");
   // The state's own arrays (a saved state edited by hand).
   const MagneticState& s = saved.state;
-  const size_t nb = cells.size(), nc = static_cast<size_t>(model_.cell_count()),
-               nm = static_cast<size_t>(model_.moment_count());
+  const size_t nb = cells.size(), nc = static_cast<size_t>(model_->cell_count()),
+               nm = static_cast<size_t>(model_->moment_count());
   const bool sized = s.pose.size() == nb && s.active.size() == nb && s.magnetization_scale.size() == nb &&
                      s.force.size() == nb && s.torque.size() == nb && s.cell_position.size() == nc &&
                      s.magnetization.size() == nc && s.applied_field.size() == nc &&
@@ -160,14 +205,14 @@ void MagneticForces::restore_state(const SavedMagneticState& saved) {
   if (!sized)
     throw std::invalid_argument(where + "the saved state's arrays do not match its " + std::to_string(nb) +
                                 " bodies, " + std::to_string(nc) + " cells and " + std::to_string(nm) + " moments");
-  state_ = s;
+  *state_ = s;
   report_ = saved.report;
 }
 
 void MagneticForces::set_external_field(const Vec3& H) {
   if (!is_finite(H))
     throw std::invalid_argument("MagneticForces::set_external_field: the field " + format(H) + " is not finite");
-  state_.external_field = H;
+  state_->external_field = H;
 }
 
 void MagneticForces::set_wake_tolerance(double tolerance) {
@@ -180,43 +225,43 @@ void MagneticForces::set_magnetization_scale(int index, double scale) {
   const int b = body_index(index, "set_magnetization_scale");
   if (!std::isfinite(scale))
     throw std::invalid_argument("MagneticForces::set_magnetization_scale: the scale of body " +
-                                std::to_string(b) + " \"" + model_.body(b).name + "\" is not finite");
-  state_.magnetization_scale[b] = scale;
+                                std::to_string(b) + " \"" + model_->body(b).name + "\" is not finite");
+  state_->magnetization_scale[b] = scale;
 }
 
 void MagneticForces::set_pose(int index, const BodyPose& pose) {
   const int b = body_index(index, "set_pose");
   if (!is_finite(pose.position) || !finite(pose.rotation))
     throw std::invalid_argument("MagneticForces::set_pose: the pose of body " + std::to_string(b) + " \"" +
-                                model_.body(b).name + "\" is not finite (position " + format(pose.position) +
+                                model_->body(b).name + "\" is not finite (position " + format(pose.position) +
                                 ", rotation " + format(pose.rotation) + ")");
-  state_.pose[b] = pose;
+  state_->pose[b] = pose;
 }
 
 Vec3 MagneticForces::moment(int index) const {
   const int b = body_index(index, "moment");
-  return state_.active[b] ? body_moment(model_, state_, b) : Vec3{};
+  return state_->active[b] ? body_moment(*model_, *state_, b) : Vec3{};
 }
 
 void MagneticForces::read_poses() {
-  for (int b = 0; b < model_.body_count(); ++b)
-    if (bodies_[b]) state_.pose[b] = ode_pose(bodies_[b]);
+  for (int b = 0; b < model_->body_count(); ++b)
+    if (bodies_[b]) state_->pose[b] = ode_pose(bodies_[b]);
 }
 
 void MagneticForces::check_inputs(const char* call) const {
   const std::string where = std::string("MagneticForces::") + call + ": ";
-  if (!is_finite(state_.external_field))
-    throw std::domain_error(where + "the external field " + format(state_.external_field) + " is not finite");
-  for (int b = 0; b < model_.body_count(); ++b) {
-    if (!state_.active[b]) continue;  // neither makes nor feels a field
-    const BodyPose& pose = state_.pose[b];
+  if (!is_finite(state_->external_field))
+    throw std::domain_error(where + "the external field " + format(state_->external_field) + " is not finite");
+  for (int b = 0; b < model_->body_count(); ++b) {
+    if (!state_->active[b]) continue;  // neither makes nor feels a field
+    const BodyPose& pose = state_->pose[b];
     const char* what = !is_finite(pose.position) ? "position" : !finite(pose.rotation) ? "rotation" : nullptr;
     if (what)
-      throw std::domain_error(where + "body " + std::to_string(b) + " \"" + model_.body(b).name + "\" has a " +
+      throw std::domain_error(where + "body " + std::to_string(b) + " \"" + model_->body(b).name + "\" has a " +
                               (bodies_[b] ? "non-finite ODE " : "non-finite ") + what + " (position " +
                               format(pose.position) + ", rotation " + format(pose.rotation) + ")");
-    if (!std::isfinite(state_.magnetization_scale[b]))
-      throw std::domain_error(where + "body " + std::to_string(b) + " \"" + model_.body(b).name +
+    if (!std::isfinite(state_->magnetization_scale[b]))
+      throw std::domain_error(where + "body " + std::to_string(b) + " \"" + model_->body(b).name +
                               "\" has a non-finite magnetization scale");
   }
 }
@@ -224,14 +269,14 @@ void MagneticForces::check_inputs(const char* call) const {
 const RelaxReport& MagneticForces::compute() {
   read_poses();
   check_inputs("compute");
-  report_ = magnetic_step(model_, state_, options_, *backend_);
+  report_ = magnetic_step(*model_, *state_, options_, *backend_);
   return report_;
 }
 
 void MagneticForces::recompute_forces() {
   read_poses();
   check_inputs("recompute_forces");
-  magnetic_forces_at_held_magnetization(model_, state_, options_, *backend_);
+  magnetic_forces_at_held_magnetization(*model_, *state_, options_, *backend_);
 }
 
 const RelaxReport& MagneticForces::apply() {
@@ -249,37 +294,37 @@ bool MagneticForces::wakes(int b) const {
   dWorldGetGravity(dBodyGetWorld(body), g);
   const Vec3 f0 = reference_force_[b], t0 = reference_torque_[b];
   const double load = norm(f0) + mass.mass * norm(Vec3{g[0], g[1], g[2]});
-  const double r = norm(shape_half_extents(model_.body(b).shape));
-  return norm(state_.force[b] - f0) > wake_tolerance_ * load ||
-         norm(state_.torque[b] - t0) > wake_tolerance_ * (norm(t0) + r * load);
+  const double r = norm(shape_half_extents(model_->body(b).shape));
+  return norm(state_->force[b] - f0) > wake_tolerance_ * load ||
+         norm(state_->torque[b] - t0) > wake_tolerance_ * (norm(t0) + r * load);
 }
 
 void MagneticForces::note_reference(int b) {
-  reference_force_[b] = state_.force[b];
-  reference_torque_[b] = state_.torque[b];
+  reference_force_[b] = state_->force[b];
+  reference_torque_[b] = state_->torque[b];
   reference_known_[b] = 1;
 }
 
 void MagneticForces::add_forces() {
-  for (int b = 0; b < model_.body_count(); ++b) add_forces_of(b);
+  for (int b = 0; b < model_->body_count(); ++b) add_forces_of(b);
 }
 
 void MagneticForces::add_forces_to(dBodyID body) {
-  for (int b = 0; b < model_.body_count(); ++b)
+  for (int b = 0; b < model_->body_count(); ++b)
     if (bodies_[b] == body) add_forces_of(b);
 }
 
 void MagneticForces::add_forces_of(int b) {
   dBodyID body = bodies_[b];
-  if (!body || !state_.active[b] || model_.body(b).inert() || dBodyIsKinematic(body)) return;
+  if (!body || !state_->active[b] || model_->body(b).inert() || dBodyIsKinematic(body)) return;
   if (!dBodyIsEnabled(body)) {
     if (!reference_known_[b]) note_reference(b);  // never seen awake: its forces now are the reference
     if (!wakes(b)) return;
     dBodyEnable(body);
   }
   note_reference(b);
-  const Vec3& f = state_.force[b];
-  const Vec3& t = state_.torque[b];
+  const Vec3& f = state_->force[b];
+  const Vec3& t = state_->torque[b];
   dBodyAddForce(body, f.x, f.y, f.z);
   dBodyAddTorque(body, t.x, t.y, t.z);
 }

@@ -1,4 +1,7 @@
-#include "engine/embedding/magnetic_stepper.h"
+#include "odemag/stepper.h"
+
+#include "engine/embedding/substeps.h"
+#include "magnetics/model/model.h"
 
 #include <algorithm>
 #include <chrono>
@@ -122,22 +125,28 @@ MagneticStepper::MagneticStepper(MagneticForces& magnetics, dWorldID world, dSpa
                                                     settings.exact_solver)),
       rigid_(*own_rigid_),
       settings_(settings),
-      rule_(settings.substeps) {}
+      rule_(std::make_unique<SubstepRule>(settings.substeps)) {}
 
 MagneticStepper::MagneticStepper(MagneticForces& magnetics, dWorldID world, RigidSubsteps& rigid,
                                  const StepperSettings& settings)
-    : magnetics_(magnetics), world_(world), rigid_(rigid), settings_(settings), rule_(settings.substeps) {}
+    : magnetics_(magnetics),
+      world_(world),
+      rigid_(rigid),
+      settings_(settings),
+      rule_(std::make_unique<SubstepRule>(settings.substeps)) {}
 
 MagneticStepper::~MagneticStepper() = default;
 
+int MagneticStepper::substeps() const { return rule_->count(); }
+
 void MagneticStepper::add_new_bodies() {
-  for (int b = rule_.body_count(); b < magnetics_.body_count(); ++b) {
+  for (int b = rule_->body_count(); b < magnetics_.body_count(); ++b) {
     dMass mass;
     dMassSetZero(&mass);
     if (dBodyID body = magnetics_.ode_body(b)) dBodyGetMass(body, &mass);
-    rule_.add_body(substep_body(magnetics_.model().body(b), mass));
+    rule_->add_body(substep_body(magnetics_.model().body(b), mass));
   }
-  motion_.resize(static_cast<size_t>(rule_.body_count()));
+  motion_.resize(static_cast<size_t>(rule_->body_count()));
 }
 
 void MagneticStepper::update_forces(double t, double h) {
@@ -156,7 +165,7 @@ void MagneticStepper::update_forces(double t, double h) {
 }
 
 void MagneticStepper::update_motion() {
-  for (int b = 0; b < rule_.body_count(); ++b) {
+  for (int b = 0; b < rule_->body_count(); ++b) {
     SubstepMotion& m = motion_[b];
     dBodyID body = magnetics_.ode_body(b);
     m.free = body && !dBodyIsKinematic(body) && dBodyIsEnabled(body);
@@ -168,7 +177,7 @@ void MagneticStepper::update_motion() {
     m.angular_velocity = vec(dBodyGetAngularVel(body));
     m.force = magnetics_.force(b);
     m.torque = magnetics_.torque(b);
-    if (rule_.body(b).turns_in_field) m.moment = magnetics_.moment(b);
+    if (rule_->body(b).turns_in_field) m.moment = magnetics_.moment(b);
     m.in_contact = rigid_.in_contact(b);
   }
 }
@@ -187,24 +196,24 @@ int MagneticStepper::substeps_needed(double dt) {
   update_motion();
   std::function<double(int)> clearance;
   if (rigid_.knows_clearance()) clearance = [this](int b) { return rigid_.clearance(b); };
-  return rule_.needed(dt, motion_, gravity_of(world_), norm(magnetics_.external_field()), clearance);
+  return rule_->needed(dt, motion_, gravity_of(world_), norm(magnetics_.external_field()), clearance);
 }
 
 void MagneticStepper::update_substeps(double dt, bool step_start) {
   const int wanted = substeps_needed(dt);
   report_.substeps_wanted = std::max(report_.substeps_wanted, wanted);
-  rule_.update(wanted, time_, dt, step_start);
+  rule_->update(wanted, time_, dt, step_start);
 }
 
 std::vector<uint8_t> MagneticStepper::bodies_to_hold(double dt) {
   update_motion();
-  const int n = rule_.body_count();
+  const int n = rule_->body_count();
   std::function<double(int)> clearance;
   if (rigid_.knows_clearance()) clearance = [this](int b) { return rigid_.clearance(b); };
   const double g = gravity_of(world_), H = norm(magnetics_.external_field());
   std::vector<uint8_t> moving(n, 0);
   for (int b = 0; b < n; ++b)
-    moving[b] = motion_[b].free && rule_.needed_by(b, dt, motion_[b], g, H, clearance) > 1;
+    moving[b] = motion_[b].free && rule_->needed_by(b, dt, motion_[b], g, H, clearance) > 1;
   std::vector<uint8_t> held(n, RelaxOptions::kHeld);
   for (int b = 0; b < n; ++b)
     if (moving[b]) held[b] = 0;
@@ -270,7 +279,7 @@ const StepReport& MagneticStepper::finish_step() {
   // falling onto a magnet reached it within one 4 ms step and was thrown out).
   double done = 0.0;
   while (true) {
-    const double h = std::min(dt / rule_.count(), dt - done);
+    const double h = std::min(dt / rule_->count(), dt - done);
     // T_r: forces added, collision, the ODE step, contacts.
     const auto t0 = std::chrono::steady_clock::now();
     rigid_.integrate(h);
@@ -285,7 +294,7 @@ const StepReport& MagneticStepper::finish_step() {
       for (size_t b = 0; b < held.size(); ++b)
         report_.held += held[b] && magnetics_.model().body(static_cast<int>(b)).responsive();
     }
-    update_forces(time_ + done, dt / rule_.count());
+    update_forces(time_ + done, dt / rule_->count());
     magnetics_.options().held_bodies.clear();
     update_substeps(dt, false);
   }

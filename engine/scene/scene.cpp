@@ -2,7 +2,8 @@
 //
 // Every value is checked where it is read, and every failure names the file
 // and the JSON key path of the offending value ("bodies[2].shape.sphere").
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
+#include "engine/scene/scene_text.h"
 
 #include <cerrno>
 #include <cmath>

@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "engine/scene/scene_text.h"
+
 namespace odemag {
 
 namespace {

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 
 namespace odemag {
 

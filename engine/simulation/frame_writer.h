@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
 
 namespace odemag {
 

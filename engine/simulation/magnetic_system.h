@@ -7,7 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
+#include "gpu/backend_choice.h"
 #include "magnetics/model/backend.h"
 #include "magnetics/model/model.h"
 #include "magnetics/relax/relax.h"
@@ -87,16 +88,6 @@ inline constexpr double kContactZoneFollowDistance = 0.5;
 // The body's pose in the scene description.
 BodyPose scene_pose(const BodyDescription& body);
 
-// The backend of a kind: cpu, cuda or automatic. automatic falls back to the CPU
-// backend when no CUDA device is usable and writes one notice to `notice`;
-// cuda without a device throws std::invalid_argument (usage error, exit 2).
-// cpu_only: a feature of the scene that only the CPU backend supports
-// (cpu_only_feature), so automatic picks it and cuda throws naming it.
-std::unique_ptr<MagneticBackend> make_backend(BackendKind kind, int threads, std::string* notice,
-                                              const std::string& cpu_only = "");
-// The backend a name gives ("cpu", "cuda" or "auto", as solver.backend and
-// --backend spell it); std::invalid_argument on any other.
-BackendKind backend_kind(const std::string& name);
 
 // "" or the first of the scene's CPU-only features, as a user reads it: graded
 // cells (solver.graded_cells), refined contact zones (solver.contact_refinement

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/embedding/magnetic_forces.h"
-#include "engine/scene/scene.h"
+#include "odemag/magnetic_forces.h"
+#include "odemag/scene.h"
 #include "engine/simulation/rigid_world.h"
 
 namespace odemag {

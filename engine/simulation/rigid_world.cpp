@@ -8,7 +8,7 @@
 #include <string>
 #include <variant>
 
-#include "engine/embedding/magnetic_forces.h"
+#include "odemag/magnetic_forces.h"
 #include "engine/simulation/winding_solids.h"
 
 namespace odemag {

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "engine/embedding/exact_step.h"
-#include "engine/embedding/magnetic_stepper.h"
-#include "engine/embedding/force_accumulator.h"
-#include "engine/scene/scene.h"
+#include "odemag/stepper.h"
+#include "odemag/magnetic_forces.h"
+#include "odemag/scene.h"
 #include "magnetics/model/state.h"
 
 namespace odemag {

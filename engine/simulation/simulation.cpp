@@ -1,4 +1,4 @@
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
 
 #include <algorithm>
 #include <chrono>
@@ -8,6 +8,12 @@
 
 
 #include "engine/simulation/magnetic_system.h"
+#include "engine/simulation/outcomes.h"
+#include "engine/simulation/rigid_world.h"
+#include "engine/simulation/timeline.h"
+#include "gpu/backend_choice.h"
+#include "magnetics/model/model.h"
+#include "magnetics/model/state.h"
 
 namespace odemag {
 
@@ -19,7 +25,9 @@ double elapsed_ms(std::chrono::steady_clock::time_point since) {
 
 }  // namespace
 
-class Simulation::TimelineOnWorld : public TimelineTarget {
+namespace {
+
+class TimelineOnWorld : public TimelineTarget {
  public:
   TimelineOnWorld(RigidWorld& world, MagneticForces& magnetics) : world_(world), magnetics_(magnetics) {}
   void set_present(int body, bool present) override {
@@ -42,14 +50,28 @@ class Simulation::TimelineOnWorld : public TimelineTarget {
   MagneticForces& magnetics_;
 };
 
-Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBackend> backend)
-    : scene_(scene), outcomes_(scene_), timeline_(scene_) {
+}  // namespace
+
+struct Simulation::Parts {
+  Parts(const SceneDescription& scene, RigidWorld& world, MagneticForces& magnetics)
+      : timeline(scene), target(world, magnetics), outcomes(scene) {}
+  Timeline timeline;
+  TimelineOnWorld target;
+  OutcomeRecorder outcomes;
+  std::vector<std::vector<RefinedZone>> contact_zones;  // by body
+  std::vector<uint8_t> contact_zones_failed;            // by body: its notice was given
+  std::vector<std::string> notices;
+};
+
+Simulation::Simulation(const SceneDescription& scene)
+    : Simulation(scene, make_backend(scene.solver.backend, scene.solver.threads, nullptr, cpu_only_feature(scene))) {}
+
+Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBackend> backend) : scene_(scene) {
   world_ = std::make_unique<RigidWorld>(scene_);
   // The magnetic model of the scene, built as for solve and field
   // (build_magnetic_system), then tied to the ODE bodies.
   MagneticSystem ms = build_magnetic_system(scene_);
-  contact_zones_ = std::move(ms.contact_zones);
-  contact_zones_failed_.assign(scene_.bodies.size(), 0);
+  std::vector<std::vector<RefinedZone>> contact_zones = std::move(ms.contact_zones);
   magnetics_ = std::make_unique<MagneticForces>(
       std::move(ms.model), std::move(ms.state), scene_.solver.relax,
       backend ? std::move(backend) : make_cpu_backend(scene_.solver.threads));
@@ -62,8 +84,10 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
   // Events at t = 0 hold already in the state at t = 0 (frame 0, the first
   // state line), as in `odemag solve`; the first step() applies them again,
   // which changes nothing.
-  timeline_target_ = std::make_unique<TimelineOnWorld>(*world_, *magnetics_);
-  timeline_.apply(0.0, scene_.simulation.time_step, *timeline_target_);
+  parts_ = std::make_unique<Parts>(scene_, *world_, *magnetics_);
+  parts_->contact_zones = std::move(contact_zones);
+  parts_->contact_zones_failed.assign(scene_.bodies.size(), 0);
+  parts_->timeline.apply(0.0, scene_.simulation.time_step, parts_->target);
 }
 
 Simulation::~Simulation() = default;
@@ -72,11 +96,11 @@ void Simulation::step() {
   if (stepper_->non_finite_body() >= 0) throw std::runtime_error(non_finite_message());
   const auto started = std::chrono::steady_clock::now();
   const double dt = scene_.simulation.time_step;
-  timeline_.apply(time(), dt, *timeline_target_);
+  parts_->timeline.apply(time(), dt, parts_->target);
   stepper_->begin_step(dt);
-  if (steps() == 0) outcomes_.sample(scene_, time(), dt, *world_, *magnetics_);  // t = 0, relaxed
+  if (steps() == 0) parts_->outcomes.sample(scene_, time(), dt, *world_, *magnetics_);  // t = 0, relaxed
   records_.push_back(stepper_->finish_step());
-  outcomes_.sample(scene_, time(), dt, *world_, *magnetics_);
+  parts_->outcomes.sample(scene_, time(), dt, *world_, *magnetics_);
   if (scene_.solver.contact_refinement) follow_contact_zones(records_.back());
   records_.back().wall_ms = elapsed_ms(started);
 }
@@ -88,27 +112,27 @@ void Simulation::follow_contact_zones(StepReport& record) {
   for (size_t b = 0; b < poses.size(); ++b) poses[b] = world_->pose(static_cast<int>(b));
   const std::vector<uint8_t>& active = magnetics_->state().active;
   for (size_t b = 0; b < scene_.bodies.size(); ++b) {
-    if (contact_zones_failed_[b] || !active[b]) continue;
+    if (parts_->contact_zones_failed[b] || !active[b]) continue;
     // The zones the scene would place at these poses (scene_contact_zones).
     std::vector<RefinedZone> zones = contact_zones(scene_, poses, active, static_cast<int>(b));
     const double h = scene_.body_cell_size(static_cast<int>(b));
     bool covered = true;
     for (const RefinedZone& wanted : zones) {
       bool near_zone = false;
-      for (const RefinedZone& zone : contact_zones_[b])
+      for (const RefinedZone& zone : parts_->contact_zones[b])
         near_zone = near_zone || norm(wanted.point - zone.point) <= kContactZoneFollowDistance * h;
       covered = covered && near_zone;
     }
     if (covered) continue;
     try {
       magnetics_->refine_body(static_cast<int>(b), zones);
-      contact_zones_[b] = std::move(zones);
+      parts_->contact_zones[b] = std::move(zones);
       ++record.rezoned;
     } catch (const std::invalid_argument& e) {  // more than kMaxRefinedCells cells
-      contact_zones_failed_[b] = 1;
+      parts_->contact_zones_failed[b] = 1;
       char t[32];
       std::snprintf(t, sizeof t, "%.4f", time());
-      notices_.push_back(scene_.file + ": body '" + scene_.bodies[b].name + "' (bodies[" +
+      parts_->notices.push_back(scene_.file + ": body '" + scene_.bodies[b].name + "' (bodies[" +
                          std::to_string(b) + "]): at t = " + t +
                          " s its refined contact zones could not follow its contacts (" + e.what() +
                          "), so its force there has the plain lattice's error");
@@ -122,7 +146,15 @@ void Simulation::advance_to(double t) {
   while (time() + 0.5 * dt < t) step();
 }
 
-void Simulation::finish() { outcomes_.finish(scene_, *world_, *magnetics_); }
+void Simulation::finish() { parts_->outcomes.finish(scene_, *world_, *magnetics_); }
+
+const std::map<std::string, double>& Simulation::outcomes() const { return parts_->outcomes.values(); }
+
+const std::vector<std::string>& Simulation::notices() const { return parts_->notices; }
+
+BodyPose Simulation::pose(int body) const { return world_->pose(body); }
+Vec3 Simulation::velocity(int body) const { return world_->velocity(body); }
+Vec3 Simulation::angular_velocity(int body) const { return world_->angular_velocity(body); }
 
 bool Simulation::finite_state(int b) const {
   const BodyPose p = world_->pose(b);

@@ -1,4 +1,8 @@
-#include "engine/simulation/solve.h"
+#include "odemag/solve.h"
+
+#include "engine/simulation/magnetic_system.h"
+#include "gpu/backend_choice.h"
+#include "magnetics/relax/relax.h"
 
 #include "magnetics/model/state.h"
 
@@ -44,6 +48,23 @@ SceneField scene_field(const SceneDescription& scene, MagneticBackend& backend, 
   f.report = relax(ms.model, ms.state, options, backend);
   field_at_points(ms.model, ms.state, backend, points, f.B, f.H);
   return f;
+}
+
+namespace {
+
+std::unique_ptr<MagneticBackend> scene_backend(const SceneDescription& scene) {
+  return make_backend(scene.solver.backend, scene.solver.threads, nullptr, cpu_only_feature(scene));
+}
+
+}  // namespace
+
+SceneSolution solve_scene(const SceneDescription& scene, const SolveProgressCallback& progress) {
+  return solve_scene(scene, *scene_backend(scene), progress);
+}
+
+SceneField scene_field(const SceneDescription& scene, const std::vector<Vec3>& points,
+                       const SolveProgressCallback& progress) {
+  return scene_field(scene, *scene_backend(scene), points, progress);
 }
 
 }  // namespace odemag

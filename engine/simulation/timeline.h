@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 #include "magnetics/model/state.h"
 
 namespace odemag {

@@ -105,6 +105,13 @@ struct RelaxReport {
   std::vector<double> residual_history;  // the convergence measure after each iteration
 };
 
+// The coupling of two cells of one body (docs/model.md): the cell-averaged
+// cube-cube (Newell) tensor, or the paper's point-dipole tensor D(r).
+enum class IntraBodyTensor {
+  cell_average,  // Newell cube-cube tensor (default)
+  point_dipole,  // the paper's point-function tensor D(r)
+};
+
 // The substep rule (docs/simulation.md "Substeps").
 struct SubstepSettings {
   // Cap on the count; 1 disables substepping (scene simulation.max_substeps).

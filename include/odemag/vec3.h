@@ -86,4 +86,11 @@ ODEMAG_HD Mat3 rotation_from_quaternion(double w, double x, double y, double z) 
   return r;
 }
 
+// A rigid body's pose: the rotation that takes body-frame vectors to the
+// world frame, and the position of its centre of mass.
+struct BodyPose {
+  Mat3 rotation;  // body frame -> world frame
+  Vec3 position;  // centre of mass, world, m
+};
+
 }  // namespace odemag

@@ -13,12 +13,10 @@
 #include <array>
 #include <vector>
 
+#include "odemag/settings.h"
+
 namespace odemag {
 
-enum class IntraBodyTensor {
-  cell_average,  // Newell cube-cube tensor (default)
-  point_dipole,  // the paper's point-function tensor D(r)
-};
 
 // Demagnetising tensor N of two cubes of edge h at lattice offset (i, j, k):
 // the mean field over cube a of cube b is -N M_b. Six components

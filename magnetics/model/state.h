@@ -9,11 +9,6 @@
 
 namespace odemag {
 
-struct BodyPose {
-  Mat3 rotation;  // body frame -> world frame
-  Vec3 position;  // centre of mass, world, m
-};
-
 // What the last converged magnetic step solved for (RelaxOptions::skip_unchanged).
 struct SolvedInputs {
   bool valid = false;

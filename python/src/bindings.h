@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 #include "magnetics/model/backend.h"
 
 namespace odemag::python {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "engine/simulation/magnetic_system.h"
-#include "engine/simulation/solve.h"
+#include "odemag/solve.h"
 #include "python/src/arrays.h"
 #include "python/src/bindings.h"
 

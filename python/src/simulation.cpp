@@ -12,9 +12,10 @@
 #include <vector>
 
 #include "engine/simulation/magnetic_system.h"
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
 #include "python/src/arrays.h"
 #include "python/src/bindings.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag::python {
 

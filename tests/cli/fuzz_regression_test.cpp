@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "cli/cli.h"
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 
 namespace odemag {
 namespace {

@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "cli/cli.h"
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 
 namespace odemag::cli {
 namespace {

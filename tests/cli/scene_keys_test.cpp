@@ -16,7 +16,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
+#include "engine/scene/scene_text.h"
 
 namespace {
 

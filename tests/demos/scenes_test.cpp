@@ -18,12 +18,13 @@
 #include <string>
 #include <variant>
 
-#include "engine/scene/scene.h"
-#include "engine/simulation/simulation.h"
+#include "odemag/scene.h"
+#include "odemag/simulation.h"
 #include "magnetics/model/backend.h"
 #include "magnetics/sources/coil.h"
 #include "odemag/constants.h"
 #include "tests/support/windings.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag {
 namespace {

@@ -21,9 +21,10 @@
 #include <cstring>
 #include <string>
 
-#include "engine/scene/scene.h"
-#include "engine/simulation/simulation.h"
+#include "odemag/scene.h"
+#include "odemag/simulation.h"
 #include "magnetics/model/backend.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag {
 namespace {

@@ -8,9 +8,10 @@
 #include <cmath>
 #include <vector>
 
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
 #include "odemag/constants.h"
 #include "tests/support/scene_builders.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag {
 namespace {

@@ -3,7 +3,8 @@
 // path) give the same forces as the same bodies attached one by one (an
 // embedder's path). Input checks (lattice limit, finite poses and fields) and
 // the wake-up of bodies ODE put to sleep.
-#include "engine/embedding/magnetic_forces.h"
+#include "odemag/magnetic_forces.h"
+#include "engine/embedding/saved_state.h"
 
 #include <gtest/gtest.h>
 #include <ode/ode.h>
@@ -18,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 #include "engine/simulation/magnetic_system.h"
 #include "magnetics/model/backend.h"
 #include "magnetics/cells/cells.h"
@@ -506,10 +507,10 @@ TEST(MagneticForcesState, RestoreIntoOtherMagneticsThrows) {
     EXPECT_NE(std::string(e.what()).find("\"nail\""), std::string::npos) << e.what();
   }
   SavedMagneticState edited = saved;  // arrays that do not fit
-  edited.state.moments.pop_back();
+  edited.data().state.moments.pop_back();
   EXPECT_THROW(a.magnetics.restore_state(edited), std::invalid_argument);
   SavedMagneticState unpredicted = saved;  // the predicted warm start's changes missing
-  unpredicted.state.previous_relaxation_change.clear();
+  unpredicted.data().state.previous_relaxation_change.clear();
   EXPECT_THROW(a.magnetics.restore_state(unpredicted), std::invalid_argument);
   EXPECT_NO_THROW(a.magnetics.restore_state(saved));
 }

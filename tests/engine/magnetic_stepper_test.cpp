@@ -13,10 +13,11 @@
 #include <limits>
 #include <stdexcept>
 
-#include "engine/embedding/magnetic_forces.h"
-#include "engine/embedding/magnetic_stepper.h"
+#include "odemag/magnetic_forces.h"
+#include "odemag/stepper.h"
 #include "engine/embedding/substeps.h"
 #include "odemag/constants.h"
+#include "magnetics/model/backend.h"
 
 namespace odemag {
 namespace {

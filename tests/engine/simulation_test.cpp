@@ -1,7 +1,7 @@
 // Rigid bodies with ODE (issue 3 "What it must show"): a ball comes to rest
 // on a magnet at 1, 4 and 10 ms steps; a compass needle's period in a uniform
 // field; momentum conservation of two attracting magnets; time-line events.
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
 
 #include <gtest/gtest.h>
 

@@ -28,6 +28,7 @@
 #include <string>
 
 #include "tests/support/stability_cases.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag::stability {
 namespace {

@@ -9,10 +9,11 @@
 #include <cmath>
 #include <random>
 
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
 #include "odemag/constants.h"
 #include "tests/support/scene_builders.h"
 #include "tests/support/windings.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag {
 namespace {

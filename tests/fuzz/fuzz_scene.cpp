@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 
 namespace {
 

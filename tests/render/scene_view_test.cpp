@@ -10,6 +10,7 @@
 
 #include "magnetics/relax/relax.h"
 #include "tests/support/scene_builders.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag {
 namespace {

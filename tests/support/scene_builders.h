@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "engine/scene/scene.h"
+#include "odemag/scene.h"
 
 namespace odemag::test_support {
 

@@ -19,12 +19,13 @@
 #include <variant>
 #include <vector>
 
-#include "engine/simulation/simulation.h"
+#include "odemag/simulation.h"
 #include "odemag/constants.h"
 #include "magnetics/kernels/kernels.h"
 #include "magnetics/near_field/near_field.h"
 #include "magnetics/relax/relax.h"
 #include "tests/support/scene_builders.h"
+#include "engine/simulation/rigid_world.h"
 
 namespace odemag::stability {
 

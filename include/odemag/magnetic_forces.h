@@ -1,6 +1,6 @@
-// Magnetics for ODE bodies: the force accumulator that the scene simulation
-// registers, and the public API for embedding odemag in an ODE program
-// (docs/embedding.md):
+// Magnetics for ODE bodies: the public API for embedding odemag in an ODE
+// program (docs/embedding.md), and the force accumulator that the scene
+// simulation registers:
 //
 //   odemag::MagneticForces magnetics;
 //   magnetics.attach(magnet_body, odemag::Box{{0.1, 0.02, 0.02}},
@@ -9,7 +9,7 @@
 //   loop { magnetics.apply(); dSpaceCollide(...); dWorldQuickStep(...); dJointGroupEmpty(...); }
 //
 // or that loop in the substeps of `odemag run`: MagneticStepper
-// (engine/embedding/magnetic_stepper.h, docs/embedding.md "Substeps").
+// (odemag/stepper.h, docs/embedding.md "Substeps").
 //
 // The moments persist from step to step (warm start), which is what makes
 // remanence possible.
@@ -23,35 +23,80 @@
 #include <string>
 #include <vector>
 
-#include "engine/embedding/force_accumulator.h"
-#include "magnetics/model/backend.h"
-#include "magnetics/model/model.h"
-#include "magnetics/relax/relax.h"
-#include "magnetics/model/state.h"
+#include "odemag/material.h"
+#include "odemag/settings.h"
+#include "odemag/shape.h"
+#include "odemag/vec3.h"
 
 namespace odemag {
 
-// A copy of the magnetic state (MagneticForces::save_state), and what it
-// belongs to: the cell and moment counts of every body it was saved from.
-struct SavedMagneticState {
-  MagneticState state;
-  RelaxReport report;                // last_report() when saved
-  std::vector<int> body_cells;       // per body: cells
-  std::vector<int> body_moments;     // per body: soft moments
-  std::vector<int> body_refinements;  // per body: refine_body calls before the save
+// The library's own types behind the API (magnetics/): opaque here.
+class MagneticBackend;
+class MagneticModel;
+struct MagneticState;
+struct RefinedZone;
+
+// Things that add forces and torques to ODE bodies before each rigid step
+// (docs/embedding.md "The API in one loop", 4: dBodyAddForce / dBodyAddTorque).
+class ForceAccumulator {
+ public:
+  virtual ~ForceAccumulator() = default;
+  // Recomputes the forces for the rigid step starting at `time` (s) of length dt.
+  virtual void update(double time, double dt) = 0;
+  // Adds the current forces and torques to the ODE bodies. ODE clears its
+  // force accumulators after every dWorldQuickStep, so this runs before each
+  // (sub)step; the forces stay those computed by the last update().
+  virtual void add_forces() = 0;
+  // Adds the forces of one body that add_forces() skipped because it was
+  // kinematic then and is dynamic now, within the same (sub)step (a rider
+  // that a body ran into: RigidWorld::ride). Bodies it does not know: nothing.
+  virtual void add_forces_to(dBodyID /*body*/) {}
+};
+
+// A copy of the magnetic state (MagneticForces::save_state): every cell's
+// moments and magnetization and what they belong to. A value: copies are
+// independent.
+class SavedMagneticState {
+ public:
+  struct Data;  // engine/embedding/saved_state.h
+  SavedMagneticState();
+  ~SavedMagneticState();
+  SavedMagneticState(const SavedMagneticState& other);
+  SavedMagneticState& operator=(const SavedMagneticState& other);
+  SavedMagneticState(SavedMagneticState&&) noexcept;
+  SavedMagneticState& operator=(SavedMagneticState&&) noexcept;
+  // The relaxation report when it was saved.
+  const RelaxReport& report() const;
+  Data& data() { return *data_; }
+  const Data& data() const { return *data_; }
+
+ private:
+  std::unique_ptr<Data> data_;
 };
 
 class MagneticForces : public ForceAccumulator {
  public:
-  // backend: nullptr for the CPU backend with all cores.
-  explicit MagneticForces(const RelaxOptions& options = {},
-                          std::unique_ptr<MagneticBackend> backend = nullptr, uint64_t seed = 1,
+  // On the CPU backend with `threads` threads (0: all cores). seed: the
+  // moments' initial directions and the noise.
+  explicit MagneticForces(const RelaxOptions& options = {}, int threads = 0, uint64_t seed = 1,
                           IntraBodyTensor intra_tensor = IntraBodyTensor::cell_average);
-
+  // On the backend of that kind: cpu, cuda, or automatic (CUDA where a
+  // device is usable, docs/gpu.md). Defined in odemag::gpu: link it (or
+  // odemag::odemag) to use this one. Throws std::invalid_argument when cuda
+  // is asked for and no device is usable.
+  MagneticForces(const RelaxOptions& options, BackendKind backend, int threads = 0, uint64_t seed = 1,
+                 IntraBodyTensor intra_tensor = IntraBodyTensor::cell_average);
+  // A backend of the library's own (the tests' and benchmarks'; nullptr:
+  // the CPU backend with all cores).
+  MagneticForces(const RelaxOptions& options, std::unique_ptr<MagneticBackend> backend, uint64_t seed = 1,
+                 IntraBodyTensor intra_tensor = IntraBodyTensor::cell_average);
   // Magnetics built elsewhere (a scene's, engine/simulation/magnetic_system.h): the
   // model and its state as they are; bind() then ties bodies to ODE bodies.
   MagneticForces(MagneticModel model, MagneticState state, const RelaxOptions& options,
                  std::unique_ptr<MagneticBackend> backend);
+  ~MagneticForces() override;
+  MagneticForces(const MagneticForces&) = delete;
+  MagneticForces& operator=(const MagneticForces&) = delete;
   // Ties magnetic body index to an ODE body (nullptr: static, set_pose) and
   // takes its pose. Throws std::out_of_range on a bad index.
   void bind(int index, dBodyID body);
@@ -106,7 +151,7 @@ class MagneticForces : public ForceAccumulator {
 
   // Throws std::invalid_argument when H is not finite.
   void set_external_field(const Vec3& H);
-  Vec3 external_field() const { return state_.external_field; }
+  Vec3 external_field() const;
   // Relative change of force or torque that wakes a sleeping body
   // (add_forces); default 1e-3, infinity never wakes. Throws
   // std::invalid_argument when negative or NaN.
@@ -115,14 +160,12 @@ class MagneticForces : public ForceAccumulator {
   // Every call taking a body index throws std::out_of_range naming the call
   // and the index when it is not 0 .. body_count() - 1.
   // A body that is not active neither makes nor feels a field (removed).
-  void set_active(int index, bool active) { state_.active[body_index(index, "set_active")] = active ? 1 : 0; }
-  bool active(int index) const { return state_.active[body_index(index, "active")] != 0; }
+  void set_active(int index, bool active);
+  bool active(int index) const;
   // Scales a permanent magnet's remanent magnetization (electromagnets, the
   // crane). Throws std::invalid_argument when scale is not finite.
   void set_magnetization_scale(int index, double scale);
-  double magnetization_scale(int index) const {
-    return state_.magnetization_scale[body_index(index, "magnetization_scale")];
-  }
+  double magnetization_scale(int index) const;
   // Pose of a static (body == nullptr) magnetic body. Throws
   // std::invalid_argument when it is not finite.
   void set_pose(int index, const BodyPose& pose);
@@ -131,12 +174,12 @@ class MagneticForces : public ForceAccumulator {
   const RelaxOptions& options() const { return options_; }
   const RelaxReport& last_report() const { return report_; }
 
-  int body_count() const { return model_.body_count(); }
+  int body_count() const;
   dBodyID ode_body(int index) const { return bodies_[body_index(index, "ode_body")]; }
   // A m^2, world; zero for a body that is not active.
   Vec3 moment(int index) const;
-  Vec3 force(int index) const { return state_.force[body_index(index, "force")]; }                  // N, world
-  Vec3 torque(int index) const { return state_.torque[body_index(index, "torque")]; }                // N m, about the CoM
+  Vec3 force(int index) const;   // N, world
+  Vec3 torque(int index) const;  // N m, about the CoM
 
   // Gives a body new refined contact zones (MagneticModel::refine_body,
   // docs/model.md "Refined contact zones"; none: its plain cells again): its
@@ -155,9 +198,11 @@ class MagneticForces : public ForceAccumulator {
   SavedMagneticState save_state() const;
   void restore_state(const SavedMagneticState& saved);
 
-  const MagneticModel& model() const { return model_; }
-  const MagneticState& state() const { return state_; }
-  MagneticState& state() { return state_; }
+  // The library's model and state (magnetics/model/): for code built with
+  // odemag's sources (tests, benchmarks, the scene simulation).
+  const MagneticModel& model() const { return *model_; }
+  const MagneticState& state() const { return *state_; }
+  MagneticState& state() { return *state_; }
   MagneticBackend& backend() { return *backend_; }
 
  private:
@@ -172,8 +217,8 @@ class MagneticForces : public ForceAccumulator {
   void note_reference(int b);
   void add_forces_of(int b);  // add_forces() for body b
 
-  MagneticModel model_;
-  MagneticState state_;
+  std::unique_ptr<MagneticModel> model_;
+  std::unique_ptr<MagneticState> state_;
   std::vector<dBodyID> bodies_;
   std::unique_ptr<MagneticBackend> backend_;
   RelaxOptions options_;

@@ -1,6 +1,6 @@
 // Scene files (docs/scene-format.md documents every key). A SceneDescription is
 // the validated, SI-unit content of one file: the demos, the tests, the
-// benchmarks and `odemag` all read scenes through it.
+// benchmarks, Python and `odemag` all read scenes through it.
 #pragma once
 
 #include <array>
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "magnetics/sources/coil.h"
+#include "odemag/coil.h"
 #include "odemag/material.h"
 #include "odemag/shape.h"
 #include "odemag/settings.h"
@@ -213,39 +213,9 @@ struct SceneDescription {
 // otherwise one cell for a sphere and the scene's cell_size for the rest.
 double lattice_spacing(const BodyDescription& body, double scene_cell_size);
 
-// One key of a scene object as the loader reads it (engine/scene/scene.cpp reads
-// every object through a table with one rule per key) and as
-// docs/scene-format.md documents it; tests/cli/scene_keys_test.cpp checks the
-// docs' key tables against these.
-struct SceneKeyDoc {
-  std::string section;  // the object: "" (top level), "materials.soft", "bodies[]", "solver", "timeline[].add", ...
-  std::string key;
-  std::string type;           // the docs' type column ("vector", "number", ...); "" where undocumented
-  std::string unit;           // the docs' unit column; "" where empty or the table has none
-  std::string default_value;  // the docs' default column ("`0`", "**required**", ...)
-  bool required = false;
-  // A plain key's value before the file sets it, from the description
-  // structs, as JSON text ("0", "[0.0,0.0,-9.81]", "\"\""); "" for keys read
-  // by their own code and for unset optionals.
-  std::string struct_default;
-};
-
-// Every key of every scene object, table by table, in the order the loader
-// reads them and lists them in "unknown key" messages.
-std::vector<SceneKeyDoc> scene_key_docs();
-
-// The text of a scene (or sweep spec) file, read in pieces up to 256 MiB.
-// Throws SceneError(path, "", ...) when it cannot be read.
-std::string read_json_file(const std::string& path);
 // Reads and validates a scene file. Throws SceneError (bad content, unknown
 // key, wrong type, NaN, negative size, missing key, unknown material, ...).
 SceneDescription load_scene(const std::string& path);
 // Same, from JSON text; `file` is used in messages.
 SceneDescription parse_scene(const std::string& json_text, const std::string& file);
-// The checks parse_scene makes on the text before it reads any key: valid,
-// finite JSON without NUL bytes, duplicate keys or nesting beyond 64 levels.
-// Throws SceneError naming `file` (and the key path where the text failed).
-// Sweep specs (engine/scene/sweep.h) are read through it too.
-void check_json_text(const std::string& json_text, const std::string& file);
-
 }  // namespace odemag

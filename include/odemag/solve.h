@@ -6,13 +6,13 @@
 #include <functional>
 #include <vector>
 
-#include "engine/scene/scene.h"
-#include "engine/simulation/magnetic_system.h"
-#include "magnetics/model/backend.h"
-#include "magnetics/relax/relax.h"
+#include "odemag/scene.h"
+#include "odemag/settings.h"
 #include "odemag/vec3.h"
 
 namespace odemag {
+
+class MagneticBackend;  // magnetics/model/backend.h: opaque here
 
 // Called after every outer iteration of the relaxation (RelaxOptions::progress).
 using SolveProgressCallback = std::function<void(const RelaxReport&)>;
@@ -37,6 +37,9 @@ struct SceneSolution {
 // (magnetic_step).
 SceneSolution solve_scene(const SceneDescription& scene, MagneticBackend& backend,
                           const SolveProgressCallback& progress = {});
+// The same on the backend the scene's solver.backend and solver.threads ask
+// for (std::invalid_argument as Simulation's constructor).
+SceneSolution solve_scene(const SceneDescription& scene, const SolveProgressCallback& progress = {});
 
 struct SceneField {
   std::vector<Vec3> B;  // T
@@ -47,6 +50,8 @@ struct SceneField {
 // `odemag field`: B and H at world points (m) of the scene relaxed as in
 // solve_scene (relax only: the field needs no forces).
 SceneField scene_field(const SceneDescription& scene, MagneticBackend& backend, const std::vector<Vec3>& points,
+                       const SolveProgressCallback& progress = {});
+SceneField scene_field(const SceneDescription& scene, const std::vector<Vec3>& points,
                        const SolveProgressCallback& progress = {});
 
 }  // namespace odemag

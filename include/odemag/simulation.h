@@ -7,20 +7,25 @@
 #include <string>
 #include <vector>
 
-#include "engine/embedding/magnetic_forces.h"
-#include "engine/embedding/magnetic_stepper.h"
-#include "engine/simulation/outcomes.h"
-#include "engine/simulation/rigid_world.h"
-#include "engine/simulation/timeline.h"
-#include "engine/scene/scene.h"
-#include "magnetics/cells/cells.h"
+#include "odemag/magnetic_forces.h"
+#include "odemag/scene.h"
+#include "odemag/stepper.h"
 
 namespace odemag {
 
+// The ODE world of a scene (engine/simulation/rigid_world.h): opaque here.
+class RigidWorld;
+
 class Simulation {
  public:
-  // backend: nullptr for the CPU backend with the scene's thread count.
-  explicit Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBackend> backend = nullptr);
+  // The scene's magnetics on the backend its solver.backend and
+  // solver.threads ask for (std::invalid_argument when "cuda" is asked for
+  // and no device is usable, or the scene needs what only the CPU backend
+  // has); a SceneError for a body whose shape or material is refused.
+  explicit Simulation(const SceneDescription& scene);
+  // On a backend of the library's own (nullptr: the CPU backend with the
+  // scene's thread count).
+  Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBackend> backend);
   ~Simulation();
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
@@ -38,6 +43,12 @@ class Simulation {
   double time() const { return stepper_->time(); }
   long steps() const { return stepper_->steps(); }
   const SceneDescription& scene() const { return scene_; }
+  // Body b's pose and velocities (scene order; m, m/s, rad/s, world frame).
+  BodyPose pose(int body) const;
+  Vec3 velocity(int body) const;
+  Vec3 angular_velocity(int body) const;
+  // The ODE world of the scene (engine/simulation/rigid_world.h): for code
+  // built with odemag's sources.
   RigidWorld& world() { return *world_; }
   const RigidWorld& world() const { return *world_; }
   MagneticForces& magnetics() { return *magnetics_; }
@@ -51,7 +62,7 @@ class Simulation {
   // each is taken the first time the simulation reaches its time (t = 0 with
   // the magnetization relaxed, then after every rigid step), statistics over
   // every step; end-of-run ones by finish().
-  const std::map<std::string, double>& outcomes() const { return outcomes_.values(); }
+  const std::map<std::string, double>& outcomes() const;
   void finish();
   // A body's state is finite (no NaN or infinity in pose, velocity, force).
   bool finite_state(int body) const;
@@ -65,11 +76,11 @@ class Simulation {
   // Notices for the user, in the order they arose (odemag run prints each
   // once): with solver.contact_refinement, a lattice ball whose zones could
   // not follow its contacts (follow_contact_zones).
-  const std::vector<std::string>& notices() const { return notices_; }
+  const std::vector<std::string>& notices() const;
 
  private:
-  // The time line's target: the rigid world and the magnetics.
-  class TimelineOnWorld;
+  // The time line and its target, the outcomes, the refined contact zones.
+  struct Parts;
 
   // solver.contact_refinement: after a step, every lattice ball with a
   // contact point (contact_points at the step's end poses) farther than
@@ -82,14 +93,9 @@ class Simulation {
   SceneDescription scene_;
   std::unique_ptr<RigidWorld> world_;
   std::unique_ptr<MagneticForces> magnetics_;
-  std::vector<StepReport> records_;
-  OutcomeRecorder outcomes_;
-  std::vector<std::vector<RefinedZone>> contact_zones_;
-  std::vector<uint8_t> contact_zones_failed_;  // by body: its notice was given
-  std::vector<std::string> notices_;
   std::unique_ptr<MagneticStepper> stepper_;
-  Timeline timeline_;
-  std::unique_ptr<TimelineOnWorld> timeline_target_;
+  std::vector<StepReport> records_;
+  std::unique_ptr<Parts> parts_;
 };
 
 }  // namespace odemag

@@ -16,11 +16,14 @@
 #include <utility>
 #include <vector>
 
-#include "engine/embedding/magnetic_forces.h"
-#include "engine/embedding/substeps.h"
+#include "odemag/magnetic_forces.h"
 #include "odemag/settings.h"
 
 namespace odemag {
+
+// The substep rule (engine/embedding/substeps.h): opaque here.
+class SubstepRule;
+struct SubstepMotion;
 
 // What one rigid step did and cost.
 struct StepReport {
@@ -110,9 +113,9 @@ class MagneticStepper {
 
   double time() const { return time_; }              // s, summed over the steps
   long steps() const { return steps_; }              // steps finished
-  int substeps() const { return rule_.count(); }     // count in use
+  int substeps() const;                              // count in use
   const StepReport& last_report() const { return report_; }
-  const SubstepRule& rule() const { return rule_; }
+  const SubstepRule& rule() const { return *rule_; }
   const StepperSettings& settings() const { return settings_; }
   // The body found non-finite (-1: none), the step (counted from 1) and the
   // time at the end of the substep it was found after.
@@ -138,7 +141,7 @@ class MagneticStepper {
   std::unique_ptr<RigidSubsteps> own_rigid_;  // the embedder's world (first constructor)
   RigidSubsteps& rigid_;
   StepperSettings settings_;
-  SubstepRule rule_;
+  std::unique_ptr<SubstepRule> rule_;
   std::vector<SubstepMotion> motion_;
   StepReport report_;
   double dt_ = 0.0;  // of the step begun
