@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "magnetics/sources/coil.h"
+#include "tests/support/team20.h"
 
 namespace odemag {
 namespace {
@@ -22,17 +23,6 @@ std::vector<Vec3> points(double half, double z0, int n) {
     p.push_back({half * (2 * a - 1), half * (2 * b - 1), z0 + half * (2 * c - 1)});
   }
   return p;
-}
-
-RoundedRectangleCoil team20() {
-  RoundedRectangleCoil c;
-  c.centre = {0.0, 0.0, 0.075};
-  c.core_half_width = c.core_half_depth = 0.0145;
-  c.inner_corner_radius = 0.005;
-  c.outer_corner_radius = 0.023;
-  c.height = 0.0966;
-  c.current = 1000.0;
-  return c;
 }
 
 void Field(benchmark::State& bench, const CoilSource& source, const std::vector<Vec3>& at) {
@@ -78,12 +68,12 @@ void ThickCircularCoil(benchmark::State& b) {
   Field(b, c, near_points());
 }
 void Team20Coil_PoleCells(benchmark::State& b) {
-  RoundedRectangleCoil c = team20();
+  RoundedRectangleCoil c = team20::coil(1000.0);
   c.quadrature_order = static_cast<int>(b.range(0));
   Field(b, c, pole_points());
 }
 void Team20Coil_InTheCopper(benchmark::State& b) {
-  RoundedRectangleCoil c = team20();
+  RoundedRectangleCoil c = team20::coil(1000.0);
   c.quadrature_order = static_cast<int>(b.range(0));
   Field(b, c, copper_points());
 }

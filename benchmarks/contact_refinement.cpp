@@ -1,4 +1,4 @@
-// Issue 12's open row: two lattice balls near contact in a field along their
+// Two lattice balls near contact in a field along their
 // line of centres. Does refining only the cells of the contact zone recover
 // the force, and how many cells does it take? (docs/validation.md section 5,
 // "Local refinement of the contact zone".)
@@ -206,8 +206,7 @@ Result solve(double R, double h, double gap_over_R, const std::vector<double>& D
     // The engine's split (magnetics/model/model.cpp build_boundary_correction): the
     // cell's own I/3 (gamma_D = 1/3 + 1/chi) and K_i = I/3 + sum_{j != i} w_j
     // N_ij - Nbar_i, Nbar_i = I/3 for a ball, its eigenvalues capped at (1 -
-    // w_i)/3 with --cap. (Until stop 43 the cap was applied to K_i - (1 - w_i)
-    // I/3, the same operator uncapped but a looser cap.)
+    // w_i)/3 with --cap.
     const double wi = a.share();
     Eigen::Matrix3d K = sum;
     if (options.cap && (!options.cap_coarse || a.edge > 0.75 * h))

@@ -15,33 +15,14 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-before=""
-after=""
-duration=""
 out="$root/benchmarks/results"
-before_scene=""
-after_scene=""
+before="" after="" duration="" before_scene="" after_scene=""
 usage() { sed -n '2,14p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --before) before=$2; shift 2 ;;
-    --after) after=$2; shift 2 ;;
-    --duration) duration=$2; shift 2 ;;
-    --out) out=$2; shift 2 ;;
-    --before-scene) before_scene=$2; shift 2 ;;
-    --after-scene) after_scene=$2; shift 2 ;;
-    -h|--help) usage; exit 0 ;;
-    *) echo "crane_timeline.sh: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
-  esac
-done
+source "$root/benchmarks/bench_common.sh"
+read_options "before after duration out before-scene after-scene" "" "$@"
 [ -n "$before" ] || { echo "crane_timeline.sh: --before PATH is required" >&2; usage >&2; exit 2; }
 if [ -z "$after" ]; then
-  build="$root/build-bench"
-  if [ ! -f "$build/CMakeCache.txt" ]; then
-    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DODEMAG_CUDA=OFF -DODEMAG_BUILD_DEMOS=OFF >/dev/null
-  fi
-  cmake --build "$build" -j2 --target crane_timeline >/dev/null
-  after="$build/bin/crane_timeline"
+  bench_program crane_timeline after
 fi
 for p in "$before" "$after"; do
   [ -x "$p" ] || { echo "crane_timeline.sh: $p is not an executable" >&2; exit 2; }

@@ -37,6 +37,7 @@
 #include "magnetics/model/backend.h"
 #include "magnetics/relax/relax.h"
 #include "magnetics/kernels/rng.h"
+#include "tests/support/magnetic_setup.h"
 
 using namespace odemag;
 
@@ -52,12 +53,7 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-SoftMaterial iron() {
-  SoftMaterial m;
-  m.saturation = 1.7e6;
-  m.susceptibility = 5000.0;
-  return m;
-}
+SoftMaterial iron() { return test_support::soft_material(1.7e6, 5000.0); }
 
 struct Scene {
   std::string name;

@@ -29,27 +29,11 @@ out="$root/benchmarks/results"
 scenes="ball_chain wood_plate iron_plate thin_iron_plate thick_iron_plate nail_and_balls crane"
 
 usage() { sed -n '2,20p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --odemag) odemag=$2; shift 2 ;;
-    --before) before=$2; shift 2 ;;
-    --threads) threads=$2; shift 2 ;;
-    --quick) quick=1; shift ;;
-    --steps) steps=$2; shift 2 ;;
-    --scenes) scenes=$2; shift 2 ;;
-    --out) out=$2; shift 2 ;;
-    -h|--help) usage; exit 0 ;;
-    *) echo "paper_scenes.sh: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
-  esac
-done
+source "$root/benchmarks/bench_common.sh"
+read_options "odemag before threads steps scenes out" "quick" "$@"
 
 if [ -z "$odemag" ]; then
-  build="$root/build-bench"
-  if [ ! -f "$build/CMakeCache.txt" ]; then
-    cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DODEMAG_CUDA=OFF -DODEMAG_BUILD_DEMOS=OFF >/dev/null
-  fi
-  cmake --build "$build" -j2 --target odemag >/dev/null
-  odemag="$build/bin/odemag"
+  bench_program odemag odemag
 fi
 [ -x "$odemag" ] || { echo "paper_scenes.sh: $odemag is not an executable" >&2; exit 2; }
 [ -z "$before" ] || [ -x "$before" ] || { echo "paper_scenes.sh: $before is not an executable" >&2; exit 2; }
@@ -167,6 +151,13 @@ def fmt(v, digits=3):
         return f"{v:.0f}" if "e+" in text else text
     return str(v)
 
+def table(f, header, cells):
+    """A Markdown table: the header's columns, then a row per list of cells."""
+    f.write("| " + " | ".join(header) + " |\n")
+    f.write("|" + "---|" * len(header) + "\n")
+    for row in cells:
+        f.write("| " + " | ".join(row) + " |\n")
+
 with open(os.path.join(out, "paper_scenes.csv"), "w") as f:
     f.write(",".join(columns) + "\n")
     for r in rows:
@@ -179,28 +170,24 @@ with open(os.path.join(out, "paper_scenes.md"), "w") as f:
             "(T_m summed over the step's substeps); ratio = paper / ours (medians), above 1: odemag is faster; "
             "cores busy: CPU seconds per wall second of the run (below the thread count: shared machine "
             "or serial parts).\n\n")
-    f.write("| scene | cells | steps | substeps mean | T_m median | T_m p90 | T_m mean | T_r median | T_r p90 | "
-            "T_r mean | iterations mean | paper cells | paper T_m | paper T_r | ratio T_m | ratio T_r | cores busy |\n")
-    f.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
-    for r in rows:
-        f.write("| " + " | ".join([
-            r["_title"], fmt(r["cells"]), fmt(r["steps"]), fmt(r["substeps_mean"], 3),
+    table(f, ["scene", "cells", "steps", "substeps mean", "T_m median", "T_m p90", "T_m mean", "T_r median",
+              "T_r p90", "T_r mean", "iterations mean", "paper cells", "paper T_m", "paper T_r", "ratio T_m",
+              "ratio T_r", "cores busy"],
+          [[r["_title"], fmt(r["cells"]), fmt(r["steps"]), fmt(r["substeps_mean"], 3),
             fmt(r["tm_median_ms"]), fmt(r["tm_p90_ms"]), fmt(r["tm_mean_ms"]), fmt(r["tr_median_ms"]),
             fmt(r["tr_p90_ms"]), fmt(r["tr_mean_ms"]), fmt(r["iterations_mean"]), fmt(r["paper_cells"]),
             fmt(r["paper_tm_ms"]), fmt(r["paper_tr_ms"]), fmt(r["ratio_tm_paper_over_ours"], 2),
-            fmt(r["ratio_tr_paper_over_ours"], 2), fmt(r["cpu_per_wall"], 2)]) + " |\n")
+            fmt(r["ratio_tr_paper_over_ours"], 2), fmt(r["cpu_per_wall"], 2)] for r in rows])
     if before:
         f.write(f"\nBefore and after, each scene run with the earlier program ({before}) just before the "
                 "current one: means per rigid step in ms; ratio = before / after (above 1: faster now).\n\n")
-        f.write("| scene | T_m before | T_m after | ratio T_m | T_r before | T_r after | ratio T_r | "
-                "iterations before | iterations after | substeps before | substeps after | outcomes before | outcomes after |\n")
-        f.write("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
-        for r in rows:
-            f.write("| " + " | ".join([
-                r["_title"], fmt(r["before_tm_mean_ms"]), fmt(r["tm_mean_ms"]), fmt(r["ratio_tm_before_over_ours"], 2),
+        table(f, ["scene", "T_m before", "T_m after", "ratio T_m", "T_r before", "T_r after", "ratio T_r",
+                  "iterations before", "iterations after", "substeps before", "substeps after", "outcomes before",
+                  "outcomes after"],
+              [[r["_title"], fmt(r["before_tm_mean_ms"]), fmt(r["tm_mean_ms"]), fmt(r["ratio_tm_before_over_ours"], 2),
                 fmt(r["before_tr_mean_ms"]), fmt(r["tr_mean_ms"]), fmt(r["ratio_tr_before_over_ours"], 2),
                 fmt(r["before_iterations_mean"]), fmt(r["iterations_mean"]),
                 fmt(r["before_substeps_mean"], 3), fmt(r["substeps_mean"], 3),
-                outcomes(r["_before_outcomes"]), outcomes(r["_outcomes"])]) + " |\n")
+                outcomes(r["_before_outcomes"]), outcomes(r["_outcomes"])] for r in rows])
 print(open(os.path.join(out, "paper_scenes.md")).read())
 EOF

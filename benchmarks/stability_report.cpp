@@ -1,4 +1,4 @@
-// The stability suite as a report (issue 7; docs/hard-cases.md): runs every
+// The stability suite as a report (docs/hard-cases.md): runs every
 // hard case of tests/engine/stability_test.cpp (same scenes, from
 // tests/support/stability_cases.h), longer where the test is kept short, and
 // writes DIR/stability.csv and DIR/stability.md.

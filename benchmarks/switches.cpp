@@ -1,5 +1,5 @@
 // What each cost-saving switch of the magnetic solve buys, in time and in
-// force error (docs/benchmarks.md "Switches"; issue 5 item 4).
+// force error (docs/benchmarks.md "Switches").
 //
 // Per scene (demos/scenes/*.json): the scene is simulated once with its own
 // settings and the magnetic inputs of a window of consecutive rigid steps are

@@ -171,7 +171,7 @@ void prepare_output_directory(const std::filesystem::path& dir) {
       throw std::runtime_error("cannot remove the previous run's " + p.string() + ": " + ec.message());
 }
 
-// --video (issue 16 item 3): the frames encoded by the ffmpeg program.
+// --video: the frames encoded by the ffmpeg program.
 
 // The file that posix_spawnp would run for `name`: the first executable
 // PATH/name (PATH unset: execvp's default /bin:/usr/bin); "" when none.

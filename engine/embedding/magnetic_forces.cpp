@@ -103,6 +103,15 @@ int MagneticForces::body_count() const { return model_->body_count(); }
 Vec3 MagneticForces::force(int index) const { return state_->force[body_index(index, "force")]; }
 Vec3 MagneticForces::torque(int index) const { return state_->torque[body_index(index, "torque")]; }
 
+void MagneticForces::field_at_points(const std::vector<Vec3>& points, std::vector<Vec3>& B,
+                                     std::vector<Vec3>& H) {
+  for (size_t p = 0; p < points.size(); ++p)
+    if (!is_finite(points[p]))
+      throw std::invalid_argument("MagneticForces::field_at_points: point " + std::to_string(p) + " " +
+                                  format(points[p]) + " is not finite");
+  odemag::field_at_points(*model_, *state_, *backend_, points, B, H);
+}
+
 int MagneticForces::body_index(int index, const char* call) const {
   if (index < 0 || index >= model_->body_count())
     throw std::out_of_range(std::string("MagneticForces::") + call + ": no magnetic body " + std::to_string(index) +

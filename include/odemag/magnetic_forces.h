@@ -180,6 +180,11 @@ class MagneticForces : public ForceAccumulator {
   Vec3 moment(int index) const;
   Vec3 force(int index) const;   // N, world
   Vec3 torque(int index) const;  // N m, about the CoM
+  // B (T) and H (A/m) at world points (m) with the magnetization of the last
+  // compute(); inside a magnetic body B = mu0 (H + M) with M of its nearest
+  // cell. Throws std::invalid_argument naming the index of a point that is
+  // not finite.
+  void field_at_points(const std::vector<Vec3>& points, std::vector<Vec3>& B, std::vector<Vec3>& H);
 
   // Gives a body new refined contact zones (MagneticModel::refine_body,
   // docs/model.md "Refined contact zones"; none: its plain cells again): its

@@ -134,9 +134,9 @@ ODEMAG_HD double cell_free_energy(const SoftCellParams& p, const Vec3& H_A, cons
     // |m_k x e|^2 = 1 - (m_k . e)^2 on the unit sphere, evaluated as the
     // cross product: near the easy axis 1 - c^2 cancels to an absolute error
     // of 1e-16 per moment, which times H_K / (2n) drowned the energy changes
-    // that the Newton polish's line search compares in weak fields (issue 14:
-    // 6% of the 8-moment cells' polishes then ran to the 40-step cap, 69% of
-    // the Newton steps of the crane's remanence phase).
+    // that the Newton polish's line search compares in weak fields (6% of
+    // the 8-moment cells' polishes ran to the 40-step cap with 1 - c^2, 69%
+    // of the Newton steps of the crane's remanence phase).
     for (int k = 0; k < p.n; ++k) s += squared_norm(cross(m[k], p.easy_axis));
     e += 0.5 * p.H_K * s / p.n;
   }

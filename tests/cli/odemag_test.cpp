@@ -744,7 +744,7 @@ TEST_F(Cli, EventsAtTimeZeroShowInSolveAndInTheFirstStateLine) {
   EXPECT_TRUE(json::parse(added.out)["bodies"][0]["present"].get<bool>());
 }
 
-// ---- --video (issue 16 item 3): the frames encoded by the ffmpeg program
+// ---- --video: the frames encoded by the ffmpeg program
 
 // `odemag ARGS` run in dir (relative --out and --video), with PATH=path when given.
 ProgramRun odemag_in(const fs::path& dir, const std::string& args, const std::string& path = "") {

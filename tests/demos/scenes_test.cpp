@@ -258,11 +258,11 @@ TEST(CraneScene, HoldsMoreBallsAtFullThanReducedAndSomeWhenOff) {
       EXPECT_GT(norm(sim.magnetics().moment(b)), 0.0) << name;
     }
   }
-  // Issue 14's weak-field regime: once the coil is off (from 4.3 s, after
-  // its ramp to zero ends at 4.2 s) the balls hang by remanence alone, and
-  // a rigid step's warm-started relaxations (one per substep) take at most
-  // 10 outer iterations in all, on average over the steps (measured 4.90;
-  // the full crane 5.94, docs/benchmarks.md 4q).
+  // The weak-field regime: once the coil is off (from 4.3 s, after its ramp
+  // to zero ends at 4.2 s) the balls hang by remanence alone, and a rigid
+  // step's warm-started relaxations (one per substep) take at most 10 outer
+  // iterations in all, on average over the steps (docs/benchmarks.md
+  // section 4: 5.8 for crane_small, 7.6 for the crane).
   double iterations = 0.0;
   int steps = 0;
   for (const StepReport& r : sim.records())

@@ -1,4 +1,4 @@
-# Comments cite files that exist (issue 13): scans the sources of magnetics/,
+# Comments cite files that exist: scans the sources of magnetics/,
 # gpu/, engine/, demos/, tests/ and benchmarks/ (*.h *.cpp *.cu *.cuh) and
 # fails, naming file and line, on
 #  (a) a citation of the specification files that live outside the repository

@@ -25,6 +25,7 @@
 #include "magnetics/cells/cells.h"
 #include "odemag/constants.h"
 #include "tests/support/contact_references.h"
+#include "tests/support/magnetic_setup.h"
 
 namespace odemag {
 namespace {
@@ -199,9 +200,7 @@ TEST(MagneticForcesApi, LatticeCountAndLimit) {
 // A magnet in a box and an iron ball on an ODE body, for the pose checks.
 struct MagnetAndBall {
   MagnetAndBall() : ball_body(ode.body_at({0.03, 0, 0})) {
-    SoftMaterial iron;
-    iron.saturation = 1.7e6;
-    iron.susceptibility = 5000;
+    const SoftMaterial iron = test_support::soft_material(1.7e6, 5000);
     magnet = magnetics.attach(nullptr, Box{{0.02, 0.01, 0.01}}, PermanentMaterial{{8e5, 0, 0}, 0.0}, 0.005, "bar");
     ball = magnetics.attach(ball_body, Sphere{0.005}, iron, 0.0, "ball");
   }
@@ -314,9 +313,7 @@ struct SleepyWorld {
     dBodySetMass(ball, &m);
     dBodySetPosition(ball, 0, 0, kRadius);
     dGeomSetBody(dCreateSphere(space, kRadius), ball);
-    SoftMaterial iron;
-    iron.saturation = 1.7e6;
-    iron.susceptibility = 5000;
+    const SoftMaterial iron = test_support::soft_material(1.7e6, 5000);
     magnetics.attach(ball, Sphere{kRadius}, iron, 0.0, "ball");
   }
   ~SleepyWorld() {
@@ -442,17 +439,10 @@ void expect_same(const Vec3& a, const Vec3& b) {
 
 struct RemanentNail {
   RemanentNail() {
-    SoftMaterial steel;
-    steel.saturation = 1.6e6;
-    steel.susceptibility = 1000;
-    steel.anisotropy_field = 8e4;
-    steel.easy_axis = {0, 0, 1};
-    steel.moments_per_cell = 8;
+    const SoftMaterial steel = test_support::anisotropic_steel(1.6e6, 1000, 8e4, 8);
     nail = magnetics.attach(nullptr, Cylinder{0.002, 0.02}, steel, 0.002, "nail");
     magnetics.set_pose(nail, BodyPose{Mat3{}, {0, 0, 0}});
-    SoftMaterial iron;
-    iron.saturation = 1.7e6;
-    iron.susceptibility = 5000;
+    const SoftMaterial iron = test_support::soft_material(1.7e6, 5000);
     ball = magnetics.attach(nullptr, Sphere{0.003}, iron, 0.0, "ball");
     magnetics.set_pose(ball, BodyPose{Mat3{}, {0, 0, 0.0135}});  // 0.5 mm beyond the nail's tip
   }
@@ -495,9 +485,7 @@ TEST(MagneticForcesState, RestoreIntoOtherMagneticsThrows) {
   fewer.attach(nullptr, Sphere{0.003}, PermanentMaterial{{0, 0, 1e6}});
   EXPECT_THROW(fewer.restore_state(saved), std::invalid_argument);
   MagneticForces coarser;  // two bodies, the nail in other cells
-  SoftMaterial steel;
-  steel.saturation = 1.6e6;
-  steel.susceptibility = 1000;
+  const SoftMaterial steel = test_support::soft_material(1.6e6, 1000);
   coarser.attach(nullptr, Cylinder{0.002, 0.02}, steel, 0.004, "nail");
   coarser.attach(nullptr, Sphere{0.003}, steel, 0.0, "ball");
   try {
@@ -523,9 +511,7 @@ TEST(MagneticForcesState, RestoreIntoOtherMagneticsThrows) {
 // a refine_body no longer restores, even where the cell counts agree.
 TEST(MagneticForcesRefine, ZonesThroughTheApiReachTheExactForce) {
   const double R = 0.005, h = R / 4.5;
-  SoftMaterial iron;
-  iron.saturation = 1e12;  // linear at these fields
-  iron.susceptibility = 1000;
+  const SoftMaterial iron = test_support::soft_material(1e12, 1000);  // linear at these fields
   MagneticForces magnetics(RelaxOptions{}, make_cpu_backend(1));
   magnetics.attach(nullptr, Sphere{R}, iron, h, "lower");
   magnetics.attach(nullptr, Sphere{R}, iron, h, "upper");
@@ -570,12 +556,7 @@ TEST(MagneticForcesMaterials, SceneMaterialGivesTheSameForceAsOneBuiltInCpp) {
     },
     "bodies": [{"name": "unused", "shape": {"sphere": 0.001}, "material": "magnet"}]
   })", "materials.json");
-  SoftMaterial steel;
-  steel.saturation = 1.6e6;
-  steel.susceptibility = 1000;
-  steel.anisotropy_field = 8e4;
-  steel.easy_axis = {0, 0, 1};
-  steel.moments_per_cell = 4;
+  const SoftMaterial steel = test_support::anisotropic_steel(1.6e6, 1000, 8e4, 4);
   const PermanentMaterial magnet{{0, 0, 9e5}};
   OdeWorld w;
   Vec3 force[2], torque[2];

@@ -1,4 +1,4 @@
-// Rigid bodies with ODE (issue 3 "What it must show"): a ball comes to rest
+// Rigid bodies with ODE: a ball comes to rest
 // on a magnet at 1, 4 and 10 ms steps; a compass needle's period in a uniform
 // field; momentum conservation of two attracting magnets; time-line events.
 #include "odemag/simulation.h"
@@ -216,7 +216,7 @@ TEST(CompassNeedle, SmallAnglePeriodAndNoNetForce) {
 // faster and slower twice a turn (about 1100 to 1300 rad/s), and nothing else
 // acts, so its fastest speed per turn must not grow (a torque update that
 // pumped energy would raise it turn by turn; a ball rolling on the crane's
-// side face keeps such speeds for a second: docs/benchmarks.md 4u). Compared
+// side face keeps such speeds for a second: docs/benchmarks.md section 4). Compared
 // over about 95 turns, after the first 0.05 s in which the magnetization
 // leaves its starting state.
 TEST(AnisotropicBall, TurnsInAUniformFieldWithoutGainingEnergy) {

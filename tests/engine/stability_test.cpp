@@ -1,4 +1,4 @@
-// The stability suite (issue 7; docs/hard-cases.md): coincident and
+// The stability suite (docs/hard-cases.md): coincident and
 // interpenetrating bodies, 10 ms steps with NdFeB, a crane heap of 1000
 // balls, external fields of 1e-3..1e7 A/m, susceptibilities up to 1e6 and
 // infinity, objects of 1 mm to 1 m, and the NaN guard. Scenes and

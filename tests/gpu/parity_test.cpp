@@ -29,6 +29,7 @@
 #include "magnetics/near_field/near_field.h"
 #include "magnetics/relax/relax.h"
 #include "magnetics/kernels/rng.h"
+#include "tests/support/magnetic_setup.h"
 #include "tests/support/test_math.h"
 
 namespace odemag {
@@ -122,12 +123,7 @@ Comparison compare(const std::vector<Vec3>& cpu, const std::vector<Vec3>& cuda, 
 
 using test_support::axis_rotation;
 
-SoftMaterial iron(double chi = 5000.0) {
-  SoftMaterial m;
-  m.saturation = 1.7e6;
-  m.susceptibility = chi;
-  return m;
-}
+SoftMaterial iron(double chi = 5000.0) { return test_support::soft_material(1.7e6, chi); }
 
 struct Scene {
   MagneticModel model;
@@ -624,12 +620,7 @@ void build_crane(Scene& s, int balls) {
   SoftMaterial core = iron(1000.0);
   core.coil_field = {0, 0, -5e5};
   m.add_body("crane", Box{{0.12, 0.12, 0.03}}, core, 0.012);  // 10 x 10 x 2 lattice
-  SoftMaterial steel;
-  steel.saturation = 8e5;
-  steel.susceptibility = 1000.0;
-  steel.anisotropy_field = 3.2e5;
-  steel.easy_axis = {0, 0, 1};
-  steel.moments_per_cell = 8;
+  const SoftMaterial steel = test_support::anisotropic_steel(8e5, 1000.0, 3.2e5, 8);
   for (int i = 0; i < balls; ++i) m.add_body("ball_" + std::to_string(i), Sphere{0.005}, steel, 0.0);
   s.state = make_state(m, 17);
   s.state.pose[0].position = {0.0, 0.0, 0.04955};

@@ -16,6 +16,7 @@
 #include "magnetics/model/model.h"
 #include "magnetics/relax/relax.h"
 #include "magnetics/model/state.h"
+#include "tests/support/magnetic_setup.h"
 #include "tests/support/test_math.h"
 
 namespace odemag {
@@ -43,11 +44,7 @@ double ball_volume() { return 4.0 / 3.0 * kPi * kBallRadius * kBallRadius * kBal
 
 // Body 0: an inert frame carrying the loop (at the origin, axis z, unless
 // posed otherwise); body 1: a one-cell ball of the given material at x.
-struct CoilAndBall {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
-};
+using CoilAndBall = test_support::MagneticSetup;
 
 CoilAndBall coil_and_ball(const Material& ball, const Vec3& x) {
   CoilAndBall s;
@@ -59,11 +56,7 @@ CoilAndBall coil_and_ball(const Material& ball, const Vec3& x) {
   return s;
 }
 
-RelaxOptions tight() {
-  RelaxOptions o;
-  o.tolerance = 1e-12;
-  return o;
-}
+RelaxOptions tight() { return test_support::relax_options(1e-12); }
 
 // A permanent ball on the axis: F_z = mu0 m dH_z/dz, the frame takes -F, and
 // the Lorentz force on the loop's current elements in the ball's dipole field
@@ -106,9 +99,7 @@ TEST(AttachedCoil, ClosedSystemHasZeroNetForceAndTorque) {
 // current (magnetization_scale of the carrying body) half the moment; the
 // coil's field is in field_at_points.
 TEST(AttachedCoil, CoilMagnetizesASoftBallAndScalesWithItsBody) {
-  SoftMaterial iron;
-  iron.saturation = 1e12;
-  iron.susceptibility = 100.0;
+  const SoftMaterial iron = test_support::soft_material(1e12, 100.0);
   for (double scale : {1.0, 0.5}) {
     CoilAndBall s = coil_and_ball(iron, {0.0, 0.0, 0.0});
     s.state.magnetization_scale[0] = scale;

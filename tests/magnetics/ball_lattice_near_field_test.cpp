@@ -19,7 +19,9 @@
 #include "magnetics/near_field/near_field.h"
 #include "magnetics/relax/relax.h"
 #include "magnetics/model/state.h"
+#include "tests/support/energy_gradient.h"
 #include "tests/support/magnetic_checks.h"
+#include "tests/support/magnetic_setup.h"
 
 namespace odemag {
 namespace {
@@ -32,19 +34,9 @@ constexpr double kH = 0.02;
 const Vec3 kMagnetSize{0.06, 0.06, 0.04};
 constexpr double kR = 0.005;
 
-SoftMaterial linear_iron(double chi) {
-  SoftMaterial s;
-  s.saturation = 1e12;  // linear
-  s.susceptibility = chi;
-  return s;
-}
+SoftMaterial linear_iron(double chi) { return test_support::soft_material(1e12, chi); }  // linear
 
-RelaxOptions tight(bool near_field = true) {
-  RelaxOptions o;
-  o.tolerance = 1e-10;
-  o.near_field = near_field;
-  return o;
-}
+RelaxOptions tight(bool near_field = true) { return test_support::relax_options(1e-10, near_field); }
 
 double rel(const Vec3& a, const Vec3& b) { return norm(a - b) / norm(b); }
 
@@ -145,11 +137,7 @@ TEST(BallLatticeNearField, QuadratureReferenceMatchesTheClosedForm) {
 // ---------------------------------------------------------------------------
 // A ball next to the ball chain's magnet (permanent, 3 x 3 x 2 cells).
 
-struct BallAndMagnet {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
-};
+using BallAndMagnet = test_support::MagneticSetup;
 
 const Vec3 kMagnetM{4e4, -3e4, -2e5};
 
@@ -302,11 +290,7 @@ TEST(BallLatticeNearField, SoftBallHasTheDipoleLevelForceOfTheBox) {
 // -dU/dx and -dU/dtheta by central differences: once near contact, once with
 // the ball pressed into the magnet (inner fade) and the core in the outer
 // window.
-struct Trio {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
-};
+using Trio = test_support::MagneticSetup;
 
 Trio trio(const Vec3& ball, const Vec3& core) {
   Trio t;
@@ -330,15 +314,9 @@ void expect_forces_are_minus_gradient(Trio& t) {
   for (int body : {0, 1, 2}) {
     magnetic_forces_at_held_magnetization(t.model, t.state, tight(), *t.backend);
     const Vec3 F = t.state.force[body], T = t.state.torque[body];
-    auto energy = [&] {
-      place_cells(t.model, t.state);
-      return magnetic_energy(t.model, t.state);
-    };
-    const Vec3 dF = test_support::minus_position_gradient(t.state.pose[body], energy, 1e-8);
-    for (int a = 0; a < 3; ++a) EXPECT_NEAR(F[a], dF[a], 1e-6 * norm(F)) << "body " << body << " force axis " << a;
+    test_support::expect_force_is_minus_energy_gradient(t.model, t.state, body, F, 1e-8);
     if (body == 1) continue;  // a ball's torque is mu0 mu x H alone
-    const Vec3 dT = test_support::minus_rotation_gradient(t.state.pose[body], energy, 1e-6);
-    for (int a = 0; a < 3; ++a) EXPECT_NEAR(T[a], dT[a], 1e-6 * norm(T)) << "body " << body << " torque axis " << a;
+    test_support::expect_torque_is_minus_energy_gradient(t.model, t.state, body, T, 1e-6);
   }
 }
 
@@ -374,15 +352,9 @@ TEST(BallLatticeNearField, ForcesAndTorquesAreMinusEnergyGradientOnAThinPlate) {
   for (int body : {0, 1}) {
     magnetic_forces_at_held_magnetization(model, state, tight(), *backend);
     const Vec3 F = state.force[body], T = state.torque[body];
-    auto energy = [&] {
-      place_cells(model, state);
-      return magnetic_energy(model, state);
-    };
-    const Vec3 dF = test_support::minus_position_gradient(state.pose[body], energy, 1e-8);
-    for (int a = 0; a < 3; ++a) EXPECT_NEAR(F[a], dF[a], 1e-6 * norm(F)) << "body " << body << " force axis " << a;
+    test_support::expect_force_is_minus_energy_gradient(model, state, body, F, 1e-8);
     if (body == 1) continue;
-    const Vec3 dT = test_support::minus_rotation_gradient(state.pose[body], energy, 1e-6);
-    for (int a = 0; a < 3; ++a) EXPECT_NEAR(T[a], dT[a], 1e-6 * norm(T)) << "body " << body << " torque axis " << a;
+    test_support::expect_torque_is_minus_energy_gradient(model, state, body, T, 1e-6);
   }
 }
 
@@ -393,15 +365,9 @@ TEST(BallLatticeNearField, ClosedSystemHasZeroNetForceAndTorque) {
   Trio t = trio(R * Vec3{0.004, -0.007, 0.02 + 1.1 * kR}, R * Vec3{0.006, -0.006, 0.02 + 2 * kR + 0.012});
   t.state.external_field = {};
   ASSERT_TRUE(magnetic_step(t.model, t.state, tight(), *t.backend).converged);
-  Vec3 F, T;
-  double scale = 0.0;
-  for (int b = 0; b < 3; ++b) {
-    F += t.state.force[b];
-    T += t.state.torque[b] + cross(t.state.pose[b].position, t.state.force[b]);
-    scale = std::max(scale, norm(t.state.force[b]));
-  }
-  EXPECT_LT(norm(F), 1e-10 * scale);
-  EXPECT_LT(norm(T), 1e-10 * scale * kH);
+  const test_support::NetForceAndTorque net = test_support::net_force_and_torque(t.model, t.state);
+  EXPECT_LT(norm(net.force), 1e-10 * net.force_scale);
+  EXPECT_LT(norm(net.torque), 1e-10 * net.force_scale * kH);
 }
 
 // A ball that moves less than the reuse tolerance (1e-3 R in the lattice
@@ -417,37 +383,34 @@ TEST(BallLatticeNearField, PairsCarriedOverWithinTheToleranceMatchAFreshEvaluati
   const Vec3 Mb = 1e5 * normalized(Vec3{0.3, 0.5, -0.8});
   const Vec3 x0{0.01, 0.01, 0.02 + 1.1 * kR};  // above a lattice vertex, 0.1 R gap
   const Vec3 move = 0.9e-3 * kR * normalized(Vec3{1.0, -2.0, 0.5});
-  auto fresh = [&](const Vec3& x, Vec3& F, Vec3& T) {
+  struct ForceAndTorque {
+    Vec3 F, T;
+  };
+  auto fresh = [&](const Vec3& x) {
     BallAndMagnet q = ball_and_magnet(x, Mb);
     magnetic_forces_at_held_magnetization(q.model, q.state, tight(), *q.backend);
-    F = q.state.force[1];
-    T = q.state.torque[1];
+    return ForceAndTorque{q.state.force[1], q.state.torque[1]};
   };
   BallAndMagnet p = ball_and_magnet(x0, Mb);
-  auto kept = [&](const Vec3& x, Vec3& F, Vec3& T) {
+  auto kept = [&](const Vec3& x) {
     p.state.pose[1].position = x;
     magnetic_forces_at_held_magnetization(p.model, p.state, tight(), *p.backend);
-    F = p.state.force[1];
-    T = p.state.torque[1];
+    return ForceAndTorque{p.state.force[1], p.state.torque[1]};
   };
-  Vec3 F0, T0, F, T, F_ref, T_ref;
-  kept(x0, F0, T0);
-  kept(x0 + move, F, T);
-  fresh(x0 + move, F_ref, T_ref);
+  const ForceAndTorque first = kept(x0), moved = kept(x0 + move), ref = fresh(x0 + move);
   std::printf("carried over %.2e R: force %.2e, torque %.2e of a fresh evaluation\n", norm(move) / kR,
-              rel(F, F_ref), rel(T, T_ref));
-  EXPECT_NE(F.x, F_ref.x);  // carried over, not evaluated again
-  EXPECT_LT(rel(F, F_ref), 2e-4);
-  EXPECT_LT(rel(T, T_ref), 1e-7);
+              rel(moved.F, ref.F), rel(moved.T, ref.T));
+  EXPECT_NE(moved.F.x, ref.F.x);  // carried over, not evaluated again
+  EXPECT_LT(rel(moved.F, ref.F), 2e-4);
+  EXPECT_LT(rel(moved.T, ref.T), 1e-7);
+  ForceAndTorque last;
   for (const Vec3& x : {x0 + 2.0 * move + 2.0 * move, x0}) {
-    kept(x, F, T);
-    fresh(x, F_ref, T_ref);
-    EXPECT_EQ(F.x, F_ref.x);
-    EXPECT_EQ(F.y, F_ref.y);
-    EXPECT_EQ(F.z, F_ref.z);
-    EXPECT_EQ(T.z, T_ref.z);
+    last = kept(x);
+    const ForceAndTorque again = fresh(x);
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(last.F[a], again.F[a]) << "force axis " << a;
+    EXPECT_EQ(last.T.z, again.T.z);
   }
-  EXPECT_EQ(F.x, F0.x);
+  EXPECT_EQ(last.F.x, first.F.x);
 }
 
 // A permanent ball pushed from a gap of R through the magnet's top face to

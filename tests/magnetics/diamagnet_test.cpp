@@ -19,6 +19,7 @@
 #include "magnetics/relax/relax.h"
 #include "magnetics/model/state.h"
 #include "tests/support/contact_references.h"
+#include "tests/support/magnetic_setup.h"
 
 namespace odemag {
 namespace {
@@ -28,11 +29,7 @@ namespace ref = reference;
 constexpr double kR = 0.005;  // both balls, m
 const Vec3 kM{0.0, 0.0, 8e5};  // the magnet ball, A/m
 
-struct MagnetAndDiamagnet {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
-};
+using MagnetAndDiamagnet = test_support::MagneticSetup;
 
 MagnetAndDiamagnet pair(double chi, const Vec3& x, double cell_size = 0.0) {
   MagnetAndDiamagnet p;
@@ -43,11 +40,7 @@ MagnetAndDiamagnet pair(double chi, const Vec3& x, double cell_size = 0.0) {
   return p;
 }
 
-RelaxOptions tight() {
-  RelaxOptions o;
-  o.tolerance = 1e-12;
-  return o;
-}
+RelaxOptions tight() { return test_support::relax_options(1e-12); }
 
 double ball_volume() { return 4.0 / 3.0 * kPi * kR * kR * kR; }
 

@@ -17,6 +17,7 @@
 #include "magnetics/model/model.h"
 #include "magnetics/relax/relax.h"
 #include "magnetics/model/state.h"
+#include "tests/support/magnetic_setup.h"
 #include "tests/support/reference_fields.h"
 
 namespace odemag {
@@ -170,11 +171,8 @@ TEST(ReferenceCuboid, PoseWrapperRotatesAndTranslates) {
 // ---------------------------------------------------------------------------
 // odemag against the references.
 
-struct Scene {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(0);
-
+struct Scene : test_support::MagneticSetup {
+  Scene() : MagneticSetup(0) {}
   void init(const Mat3& rotation = {}, const Vec3& position = {}) {
     state = make_state(model, 7);
     state.pose[0] = {rotation, position};
@@ -190,11 +188,7 @@ struct Scene {
   }
 };
 
-RelaxOptions tight() {
-  RelaxOptions o;
-  o.tolerance = 1e-10;
-  return o;
-}
+RelaxOptions tight() { return test_support::relax_options(1e-10); }
 
 // 2. A one-cell permanent sphere is a uniformly magnetized sphere: outside,
 // exactly the dipole field (odemag's kernel is the exact dipole beyond the

@@ -21,6 +21,7 @@
 #include "magnetics/relax/relax.h"
 #include "magnetics/model/state.h"
 #include "tests/support/magnetic_checks.h"
+#include "tests/support/magnetic_setup.h"
 
 namespace odemag {
 namespace {
@@ -30,12 +31,7 @@ constexpr double kH = 1e-3;  // lattice spacing of every body below, m
 using test_support::axis_rotation;
 
 // Linear soft iron: chi = 1000 with a saturation far above the fields used.
-SoftMaterial linear_iron() {
-  SoftMaterial iron;
-  iron.saturation = 1e9;
-  iron.susceptibility = 1000.0;
-  return iron;
-}
+SoftMaterial linear_iron() { return test_support::soft_material(1e9, 1000.0); }
 
 double rel(const Vec3& a, const Vec3& b) { return norm(a - b) / norm(b); }
 
@@ -194,10 +190,7 @@ TEST(LatticeNearField, CutCubeKeepsItsForceNextToAMagnet) {
 // body, a block of whole cells or a ball of partial ones (their points off
 // the lattice sites), is relaxed once; its moments then stay fixed in its
 // body frame.
-struct MagnetAndBlock {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
+struct MagnetAndBlock : test_support::MagneticSetup {
   MagnetAndBlock(double gap, double tilt, bool ball = false) {
     model.add_body("magnet", Box{{4 * kH, 4 * kH, 4 * kH}}, PermanentMaterial{{3e5, -2e5, 8e5}, 0.0}, kH);
     if (ball)

@@ -229,7 +229,7 @@ TEST(NewtonPolish, StructuredStepEqualsDenseNewtonStep) {
   EXPECT_GE(checked, 30);  // most configurations take the structured path
 }
 
-// Issue 14: a nearly demagnetized 8-moment steel cell (moments near +-e,
+// A nearly demagnetized 8-moment steel cell (moments near +-e,
 // mean(m) ~ 1e-3) in a weak field. Its energy is a sum of terms up to H_K / 2
 // = 1.6e5 A/m whose changes near convergence are 1e-13 and less, so the
 // Newton polish's line search must see them: with the anisotropy term

@@ -1,4 +1,4 @@
-// Non-finite cells fail a relaxation (issue 15): a NaN in the external field,
+// Non-finite cells fail a relaxation: a NaN in the external field,
 // a moment or a body's field makes every relaxation scheme report itself not
 // converged with a non-finite residual, never converged. The residual maxima
 // (std::max, fmax, OpenMP's max reduction) drop NaN, so without the explicit
@@ -18,6 +18,7 @@
 #include "magnetics/model/backend.h"
 #include "magnetics/model/model.h"
 #include "magnetics/relax/relax.h"
+#include "tests/support/magnetic_setup.h"
 
 using namespace odemag;
 
@@ -25,12 +26,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-SoftMaterial iron() {
-  SoftMaterial m;
-  m.saturation = 1.6e6;
-  m.susceptibility = 1000;
-  return m;
-}
+SoftMaterial iron() { return test_support::soft_material(1.6e6, 1000); }
 
 // A permanent bar, a recoil magnet, 24 one-cell soft balls (more than the 16
 // cells from which the CPU backend's relax_cells runs in parallel), one of

@@ -146,14 +146,14 @@ PairResult refined_pair(double R_over_h, double gap_over_R, const Vec3& line, co
   return {state.force[1], model.body(0).cell_count(), report.iterations, report.converged};
 }
 
-// 3. Issue 12's open row: two lattice balls near contact in a field along
+// 3. Two lattice balls near contact in a field along
 // their line of centres, at R/h = 4.5 (565 cells per ball plain). With the
 // line along a lattice axis the plain lattice's force is 15% / 7.5% too weak
 // at 0.05 R / 0.1 R; along (1, 2, 2) / 3, oblique to the lattice axes, 26% /
 // 7% (benchmarks/results/refined_contact.md). With the default zones (915 / 953 cells per ball) the
 // force is within 3% of the exact two-centre series: measured +0.8% / +0.4%
 // along z, -0.4% / +0.3% along (1, 2, 2) / 3 at chi = 1000, -2.2% at chi =
-// 10, with the field across 0.5% (stop 44, its z sub-cubes capped: -0.1% /
+// 10, with the field across 0.5% (with its z sub-cubes capped: -0.1% /
 // +0.1%, -1.1% / -0.2%, -2.6%, 0.5%).
 TEST(RefinedZone, TwoBallsNearContactMatchTheExactForce) {
   struct Case {
@@ -187,9 +187,9 @@ TEST(RefinedZone, TwoBallsNearContactMatchTheExactForce) {
 }
 
 // 3b. Along the oblique line at R/h = 5 (1065 cells per ball): measured
-// +0.67% at 0.05 R (stop 44, the exact part on every sub-cube: -1.1%).
-// With the boundary correction's local part capped on the sub-cubes too
-// (before stop 44) it overshot by +3.0% (+1.4% at R/h = 4): the cap, a
+// +0.67% at 0.05 R (with the exact part on every sub-cube: -1.1%). With
+// the boundary correction's local part capped on the sub-cubes too it
+// overshoots by +3.0% (+1.4% at R/h = 4): the cap, a
 // stability device for coarse cells, added +4% to +6% at the contact
 // (docs/model.md "Refined contact zones").
 TEST(RefinedZone, ObliqueContactDoesNotOvershootOnFinerLattices) {
@@ -235,9 +235,9 @@ TEST(RefinedZone, IndefiniteExactCorrectionFallsBackToTheCap) {
 // along both lines tried, z (the contact point on lattice planes) and (1,
 // 2, 2) / 3, at R/h 4, 4.5 and 5, for chi = 1000 and 1e4: add_body's
 // positivity check passes, so a contact that moves does not switch the
-// rule. Until stop 45 the whole sub-cubes took it too, and along z a swirl
-// of M about the contact axis in a ring of h/2 cubes went below zero, so
-// those bodies fell back to the cap (-2.3% at R/h 4).
+// rule. With the whole sub-cubes taking it too, along z a swirl of M about
+// the contact axis in a ring of h/2 cubes goes below zero, so those bodies
+// fall back to the cap (-2.3% at R/h 4).
 TEST(RefinedZone, DefaultZonesKeepTheExactPartAlongEveryLine) {
   for (const double chi : {1000.0, 1e4})
     for (const double R_over_h : {4.0, 4.5, 5.0})

@@ -2,8 +2,8 @@
 // reference of tests/support/contact_references.h (the magnetometric
 // demagnetizing factor N_m(chi), Richardson-extrapolated): the mean
 // magnetization in a uniform field, chi H0 / (1 + N_m chi). The uniform
-// lattice of cubes (the default) and graded cells (issue 12: "within 1% at
-// <= 1000 cells", MagneticModel::set_graded_cells, docs/model.md "Graded
+// lattice of cubes (the default) and graded cells (within 1% at <= 1000
+// cells, MagneticModel::set_graded_cells, docs/model.md "Graded
 // cells"). Both are Galerkin discretizations with piecewise-constant M, so
 // both stay below the reference.
 #include <gtest/gtest.h>
@@ -101,7 +101,7 @@ TEST(SoftCube, GradedCellsWithinOnePercentAtAThousandCells) {
     EXPECT_LT(std::fabs(eg), std::fabs(eu)) << n;
     previous = eg;
   }
-  EXPECT_LT(std::fabs(previous), 0.01);  // issue 12: within 1% at <= 1000 cells (measured 0.80%)
+  EXPECT_LT(std::fabs(previous), 0.01);  // within 1% at <= 1000 cells (measured 0.80%)
 }
 
 // Other susceptibilities, graded at 512 and 1000 cells, against the same

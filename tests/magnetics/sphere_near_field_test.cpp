@@ -12,33 +12,23 @@
 #include "magnetics/model/backend.h"
 #include "magnetics/relax/relax.h"
 #include "tests/support/contact_references.h"
+#include "tests/support/energy_gradient.h"
 #include "tests/support/magnetic_checks.h"
+#include "tests/support/magnetic_setup.h"
 
 namespace odemag {
 namespace {
 
 constexpr double kR = 0.01;  // ball radius, m
 
-RelaxOptions tight(bool near_field = true) {
-  RelaxOptions o;
-  o.tolerance = 1e-10;
-  o.near_field = near_field;
-  return o;
-}
+RelaxOptions tight(bool near_field = true) { return test_support::relax_options(1e-10, near_field); }
 
-SoftMaterial linear_iron(double chi) {
-  SoftMaterial s;
-  s.saturation = 1e12;  // far above any field here: linear
-  s.susceptibility = chi;
-  return s;
-}
+// Saturation far above any field here: linear.
+SoftMaterial linear_iron(double chi) { return test_support::soft_material(1e12, chi); }
 
 using test_support::axis_rotation;
 
-struct Pair {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
+struct Pair : test_support::MagneticSetup {
   RelaxReport solve(const RelaxOptions& o) { return magnetic_step(model, state, o, *backend); }
 };
 
@@ -185,20 +175,10 @@ TEST(SphereNearField, ForcesAndTorquesAreMinusEnergyGradient) {
     p.backend->begin_step(p.model, p.state);
     p.backend->forces(p.model, p.state);
     const Vec3 F = p.state.force[body], T = p.state.torque[body];
-    auto energy = [&] {
-      place_cells(p.model, p.state);
-      return magnetic_energy(p.model, p.state);
-    };
-    const double dx = 1e-8;
-    const Vec3 dF = test_support::minus_position_gradient(p.state.pose[body], energy, dx);
-    for (int a = 0; a < 3; ++a)
-      EXPECT_NEAR(F[a], dF[a], 1e-6 * norm(F)) << "body " << body << " force axis " << a;
-    const double dtheta = 1e-6;
+    test_support::expect_force_is_minus_energy_gradient(p.model, p.state, body, F, 1e-8);
     if (body != 0) continue;
     ASSERT_GT(norm(T), 0.0);
-    const Vec3 dT = test_support::minus_rotation_gradient(p.state.pose[body], energy, dtheta);
-    for (int a = 0; a < 3; ++a)
-      EXPECT_NEAR(T[a], dT[a], 1e-6 * norm(T)) << "body " << body << " torque axis " << a;
+    test_support::expect_torque_is_minus_energy_gradient(p.model, p.state, body, T, 1e-6);
   }
 }
 
@@ -213,15 +193,9 @@ TEST(SphereNearField, ClosedSystemHasZeroNetForceAndTorque) {
   p.state.pose[1].position = {0.002, 0, 2.05 * kR};
   p.state.pose[2].position = {0.004, 0.003, 4.15 * kR};
   ASSERT_TRUE(p.solve(tight()).converged);
-  Vec3 F, T;
-  double scale = 0.0;
-  for (int b = 0; b < 3; ++b) {
-    F += p.state.force[b];
-    T += p.state.torque[b] + cross(p.state.pose[b].position, p.state.force[b]);
-    scale = std::max(scale, norm(p.state.force[b]));
-  }
-  EXPECT_LT(norm(F), 1e-10 * scale);
-  EXPECT_LT(norm(T), 1e-10 * scale * kR);
+  const test_support::NetForceAndTorque net = test_support::net_force_and_torque(p.model, p.state);
+  EXPECT_LT(norm(net.force), 1e-10 * net.force_scale);
+  EXPECT_LT(norm(net.torque), 1e-10 * net.force_scale * kR);
 }
 
 // Carried-over pairs (magnetics/near_field/sphere_near_field.cpp): a soft ball 0.1 R

@@ -13,28 +13,19 @@
 #include "magnetics/model/backend.h"
 #include "magnetics/model/model.h"
 #include "magnetics/relax/relax.h"
+#include "tests/support/magnetic_setup.h"
 
 using namespace odemag;
 
 namespace {
 
 // Steel balls as in the crane: anisotropic, eight moments a cell, remanent.
-SoftMaterial crane_steel() {
-  SoftMaterial steel;
-  steel.saturation = 1.6e6;
-  steel.susceptibility = 1000;
-  steel.anisotropy_field = 3.2e5;
-  steel.moments_per_cell = 8;
-  return steel;
-}
+SoftMaterial crane_steel() { return test_support::anisotropic_steel(1.6e6, 1000, 3.2e5, 8); }
 
 // A bar magnet and a chain of three steel balls below it that moves towards
 // it by the same small distance before every relaxation, as a clump carried
 // by a crane does from substep to substep.
-struct MovingChain {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
+struct MovingChain : test_support::MagneticSetup {
   RelaxOptions options;
   explicit MovingChain(bool predict) {
     model.add_body("magnet", Box{{0.02, 0.02, 0.01}}, PermanentMaterial{{0, 0, 9e5}, 0.0}, 0.0);

@@ -15,23 +15,16 @@
 #include "magnetics/model/backend.h"
 #include "magnetics/model/model.h"
 #include "magnetics/relax/relax.h"
+#include "tests/support/magnetic_setup.h"
 
 using namespace odemag;
 
 namespace {
 
-SoftMaterial soft_iron() {  // isotropic: keeps no moment
-  SoftMaterial iron;
-  iron.saturation = 1.6e6;
-  iron.susceptibility = 1000;
-  return iron;
-}
+SoftMaterial soft_iron() { return test_support::soft_material(1.6e6, 1000); }  // isotropic: keeps no moment
 
 // An iron cube of 4 x 4 x 4 cells with two iron balls against its top face.
-struct IronGroup {
-  MagneticModel model;
-  MagneticState state;
-  std::unique_ptr<MagneticBackend> backend = make_cpu_backend(1);
+struct IronGroup : test_support::MagneticSetup {
   RelaxOptions options;
   IronGroup() {
     model.add_body("core", Box{{0.04, 0.04, 0.04}}, soft_iron(), 0.01);

@@ -1,4 +1,4 @@
-// The stability suite's scenes and measurements (issue 7; docs/hard-cases.md),
+// The stability suite's scenes and measurements (docs/hard-cases.md),
 // shared by tests/engine/stability_test.cpp, which asserts on them, and
 // benchmarks/stability_report.cpp, which tabulates them: both run the same
 // scenes.
