@@ -159,6 +159,7 @@ int run_solve(const std::vector<std::string>& args) {
   const SceneDescription scene = load_scene(c.scene);
   check_cell_pairs(scene, options);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
+  for (const std::string& notice : scene_notices(scene)) std::fprintf(stderr, "odemag solve: %s\n", notice.c_str());
   const RelaxOptions& relax_options = scene.solver.relax;
   const SceneSolution solution =
       solve_scene(scene, *backend, SolveProgress(relax_options.tolerance, relax_options.max_iterations));
@@ -196,6 +197,7 @@ int run_field(const std::vector<std::string>& args) {
   check_cell_pairs(scene, options);
   const std::vector<Vec3> points = read_points(c.points);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
+  for (const std::string& notice : scene_notices(scene)) std::fprintf(stderr, "odemag field: %s\n", notice.c_str());
   const RelaxOptions& relax_options = scene.solver.relax;
   const SceneField field =
       scene_field(scene, *backend, points, SolveProgress(relax_options.tolerance, relax_options.max_iterations));

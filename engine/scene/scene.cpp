@@ -955,7 +955,7 @@ const KeyTable<SolverSettings> kSolverKeys = {
     {.name = "graded_cells", .check = Check::boolean, .slot = SLOT(graded_cells),
      .doc = {"bool", "", "`false`"}},
     {.name = "contact_refinement", .check = Check::boolean, .slot = SLOT(contact_refinement),
-     .doc = {"bool", "", "`false`"}},
+     .doc = {"bool", "", "`true`"}},
     {.name = "backend",
      .read = [](const SceneReader& r, const json& x, const std::string& p, SolverSettings& s) {
        s.backend = read_choice(r, x, p, kBackendChoices);

@@ -1,5 +1,7 @@
 #include "engine/simulation/magnetic_system.h"
 
+#include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 #include "engine/simulation/timeline.h"
@@ -62,13 +64,31 @@ std::vector<RefinedZone> contact_zones(const SceneDescription& scene,
   return zones;
 }
 
+namespace {
+
+// Whether the zones give the body at most kMaxRefinedCells cells.
+bool zones_fit(const Shape& shape, double h, const std::vector<RefinedZone>& zones) {
+  try {
+    make_refined_cells(shape, h, zones);
+    return true;
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene) {
   std::vector<std::vector<RefinedZone>> zones(scene.bodies.size());
   if (!scene.solver.contact_refinement) return zones;
   std::vector<BodyPose> poses;
   for (const BodyDescription& body : scene.bodies) poses.push_back(scene_pose(body));
-  for (size_t b = 0; b < scene.bodies.size(); ++b)
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
     zones[b] = contact_zones(scene, poses, {}, static_cast<int>(b));
+    // Beyond the cap the ball keeps its plain cells (scene_notices says so).
+    if (!zones[b].empty() && !zones_fit(scene.bodies[b].shape, scene.body_cell_size(static_cast<int>(b)), zones[b]))
+      zones[b].clear();
+  }
   return zones;
 }
 
@@ -132,6 +152,35 @@ void apply_events_at_start(const SceneDescription& scene, MagneticSystem& system
   place_cells(system.model, system.state);
 }
 
+std::vector<std::string> scene_notices(const SceneDescription& scene) {
+  std::vector<std::string> notices;
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    const BodyDescription& body = scene.bodies[b];
+    const Material& material = scene.materials.at(body.material);
+    const double h = scene.body_cell_size(static_cast<int>(b));
+    if (scene.solver.contact_refinement && takes_contact_zones(scene, static_cast<int>(b))) {
+      std::vector<BodyPose> poses;
+      for (const BodyDescription& d : scene.bodies) poses.push_back(scene_pose(d));
+      const std::vector<RefinedZone> zones = contact_zones(scene, poses, {}, static_cast<int>(b));
+      if (!zones.empty() && !zones_fit(body.shape, h, zones))
+        notices.push_back(scene.file + ": body '" + body.name + "' (bodies[" + std::to_string(b) +
+                          "]) keeps its plain cells near its contacts: refined zones there would give it more "
+                          "than " + std::to_string(kMaxRefinedCells) +
+                          " cells (force at the contact up to 20% low); a larger cell_size allows them");
+    }
+    if (!(h > 0.0) || !has_positive_susceptibility(material) || uses_volume_shares(body.shape, h)) continue;
+    const Vec3 half = shape_half_extents(body.shape);
+    const double thinnest = 2.0 * std::min({half.x, half.y, half.z});
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "is %.3g mm thin at a cell size of %.3g mm: its cells keep its moment but not where its "
+                  "material is (forces and fields near it poor); a cell_size of at most %.3g mm fixes that",
+                  thinnest * 1e3, h * 1e3, 0.5 * thinnest * 1e3);
+    notices.push_back(scene.file + ": body '" + body.name + "' (bodies[" + std::to_string(b) + "]) " + text);
+  }
+  return notices;
+}
+
 SceneCellCounts count_scene_cells(const SceneDescription& scene) {
   SceneCellCounts counts;
   const std::vector<std::vector<RefinedZone>> scene_zones = scene_contact_zones(scene);
@@ -145,7 +194,9 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene) {
     try {
       if (h > 0.0)
         cells = static_cast<double>(
-            (zones.empty() ? make_cells(body.shape, h) : make_refined_cells(body.shape, h, zones)).size());
+            (zones.empty() ? make_cells(body.shape, h, has_positive_susceptibility(material))
+                           : make_refined_cells(body.shape, h, zones))
+                .size());
     } catch (const std::invalid_argument& e) {  // refined zones beyond kMaxRefinedCells
       throw SceneError(scene.file, "bodies[" + std::to_string(b) + "]", e.what());
     }

@@ -46,6 +46,13 @@ struct SceneCellCounts {
 };
 SceneCellCounts count_scene_cells(const SceneDescription& scene);
 
+// Where the scene's cells are known to be poor and the program cannot make
+// them better itself, one line per body naming it, the reason and what to
+// change: a responsive body under kMinVolumeShareExtent cells across along
+// some axis keeps centre-inside cells (docs/model.md "Cells"), which keep its
+// moment but not where its material is.
+std::vector<std::string> scene_notices(const SceneDescription& scene);
+
 // The refined contact zones of every body, indexed as scene.bodies
 // (docs/model.md "Refined contact zones"). With solver.contact_refinement, a
 // lattice ball of a material with positive susceptibility (soft, or a magnet

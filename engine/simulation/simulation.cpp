@@ -87,6 +87,7 @@ Simulation::Simulation(const SceneDescription& scene, std::unique_ptr<MagneticBa
   parts_ = std::make_unique<Parts>(scene_, *world_, *magnetics_);
   parts_->contact_zones = std::move(contact_zones);
   parts_->contact_zones_failed.assign(scene_.bodies.size(), 0);
+  parts_->notices = scene_notices(scene_);
   parts_->timeline.apply(0.0, scene_.simulation.time_step, parts_->target);
 }
 

@@ -74,7 +74,7 @@ struct SolverSettings {
   // Refined contact zones for lattice balls near other bodies at the scene's
   // poses (engine/simulation/magnetic_system.h scene_contact_zones, docs/model.md
   // "Refined contact zones"); CPU backend only.
-  bool contact_refinement = false;
+  bool contact_refinement = true;
 };
 
 struct ContactSettings {

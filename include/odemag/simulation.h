@@ -74,8 +74,9 @@ class Simulation {
   // steps from 1 and T the end of the substep.
   std::string non_finite_message() const;
   // Notices for the user, in the order they arose (odemag run prints each
-  // once): with solver.contact_refinement, a lattice ball whose zones could
-  // not follow its contacts (follow_contact_zones).
+  // once): bodies whose cells are known to be poor (scene_notices,
+  // engine/simulation/magnetic_system.h); a lattice ball whose refined
+  // contact zones could not follow its contacts (follow_contact_zones).
   const std::vector<std::string>& notices() const;
 
  private:

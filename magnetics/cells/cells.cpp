@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "magnetics/cells/demag_tensor.h"
 #include "magnetics/kernels/cell_field.h"
 #include "odemag/constants.h"
 
@@ -338,6 +339,21 @@ CellSet centre_inside_cells(const Shape& shape, double cell_size) {
   }
   cells.cell_volume = volume / static_cast<double>(cells.size());
   cells.volumes.assign(cells.size(), cells.cell_volume);
+  // A box's cells: the part of the box each stands for, where the cells tile
+  // it (a thin box's one layer: the layer, not the cube of edge h): extents
+  // e_k = min(h, 2 (L_k/2 - |c_k|)), kept where they account for the cell's
+  // volume; elsewhere the cube.
+  if (const Box* box = std::get_if<Box>(&shape); box && cells.spacing > 0.0) {
+    const double h = cells.spacing;
+    for (int i = 0; i < cells.size(); ++i) {
+      const Vec3& c = cells.local_positions[i];
+      Vec3 e;
+      for (int k = 0; k < 3; ++k) e[k] = std::min(h, 2.0 * (0.5 * box->size[k] - std::fabs(c[k])));
+      const bool tiles = e.x > 0.0 && e.y > 0.0 && e.z > 0.0 &&
+                         std::fabs(e.x * e.y * e.z - cells.cell_volume) <= 1e-6 * cells.cell_volume;
+      cells.part_halves.push_back(tiles ? 0.5 * e : Vec3{0.5 * h, 0.5 * h, 0.5 * h});
+    }
+  }
   cells.contact_radius = cells.spacing > 0.0 ? 0.5 * cells.spacing : std::min({half.x, half.y, half.z});
   cells.contact_radii.assign(cells.size(), cells.contact_radius);
   cells.cell_radius = std::cbrt(3.0 * cells.cell_volume / (4.0 * kPi));
@@ -383,16 +399,25 @@ std::array<int, 3> volume_share_extent(const Shape& shape, double h) {
 CellSet volume_share_cells(const Shape& shape, double h) {
   CellSet cells;
   const std::array<int, 3> n = volume_share_extent(shape, h);
+  const Box* box = std::get_if<Box>(&shape);
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
       for (int i = 0; i < n[0]; ++i) {
-        const ShareCell c = share_cell(shape, lattice_site(n, h, {i, j, k}), h);
+        const Vec3 site = lattice_site(n, h, {i, j, k});
+        const ShareCell c = share_cell(shape, site, h);
         if (c.volume == 0.0) continue;
         if (!c.whole) cells.whole_cells = false;
         cells.local_positions.push_back(c.centroid);
         cells.lattice_index.push_back({i, j, k});
         cells.volumes.push_back(c.volume);
         cells.contact_radii.push_back(c.contact);
+        if (box) {  // the part cube ∩ box, a cuboid about the centroid
+          Vec3 half;
+          for (int a = 0; a < 3; ++a)
+            half[a] = 0.5 * (std::min(site[a] + 0.5 * h, 0.5 * box->size[a]) -
+                             std::max(site[a] - 0.5 * h, -0.5 * box->size[a]));
+          cells.part_halves.push_back(c.whole ? Vec3{0.5 * h, 0.5 * h, 0.5 * h} : half);
+        }
       }
   cells.lattice_extent = n;
   cells.spacing = h;
@@ -404,8 +429,9 @@ CellSet volume_share_cells(const Shape& shape, double h) {
 
 }  // namespace
 
-bool uses_volume_shares(const Shape& shape, double cell_size) {
-  if (!(cell_size > 0.0) || std::holds_alternative<Box>(shape)) return false;
+bool uses_volume_shares(const Shape& shape, double cell_size, bool responsive) {
+  if (!(cell_size > 0.0)) return false;
+  if (!responsive) return true;
   const Vec3 half = shape_half_extents(shape);
   for (int a = 0; a < 3; ++a)
     if (2.0 * half[a] < kMinVolumeShareExtent * cell_size) return false;
@@ -475,9 +501,9 @@ CellSet make_graded_box_cells(const Shape& shape, double cell_size) {
   return cells;
 }
 
-CellSet make_cells(const Shape& shape, double cell_size) {
-  return uses_volume_shares(shape, cell_size) ? volume_share_cells(shape, cell_size)
-                                              : centre_inside_cells(shape, cell_size);
+CellSet make_cells(const Shape& shape, double cell_size, bool responsive) {
+  return uses_volume_shares(shape, cell_size, responsive) ? volume_share_cells(shape, cell_size)
+                                                          : centre_inside_cells(shape, cell_size);
 }
 
 std::vector<double> default_refinement_radii(double cell_size) {
@@ -486,8 +512,8 @@ std::vector<double> default_refinement_radii(double cell_size) {
 
 CellSet make_refined_cells(const Shape& shape, double cell_size, const std::vector<RefinedZone>& zones) {
   if (!uses_volume_shares(shape, cell_size))
-    throw std::invalid_argument(
-        "refined zones need a curved body (ball or cylinder) at least 2 cells across (volume-share cells)");
+    throw std::invalid_argument("refined zones need a body at least 2 cells across along every axis "
+                                "(volume-share cells)");
   for (const RefinedZone& z : zones) {
     if (!is_finite(z.point)) throw std::invalid_argument("refined zone: the point must be finite");
     if (z.radii.size() > kMaxRefinementLevels)
@@ -560,9 +586,19 @@ void uniform_demag_over_cell(const Shape& shape, const CellSet& cells, int i, do
   const Vec3 rlo = site - half, rhi = site + half;
   std::visit(Overloaded{
                  [&](const Sphere&) { n[0] = n[3] = n[5] = 1.0 / 3.0; },
-                 [&](const Box&) {
-                   // Boxes have whole cells (uses_volume_shares) and no boundary correction.
-                   throw std::logic_error("uniform_demag_over_cell: a box has no volume-share cells");
+                 [&](const Box& b) {
+                   // The mean over the cell's part (a cuboid) of the box's own
+                   // field: the mutual tensor of the two cuboids.
+                   const Vec3 e = 0.5 * b.size;
+                   double lo[3], hi[3], part[3], whole[3], d[3];
+                   for (int k = 0; k < 3; ++k) {
+                     lo[k] = std::max(rlo[k], -e[k]);
+                     hi[k] = std::min(rhi[k], e[k]);
+                     part[k] = 0.5 * (hi[k] - lo[k]);
+                     whole[k] = e[k];
+                     d[k] = 0.5 * (lo[k] + hi[k]);
+                   }
+                   cuboid_demag_tensor(part, whole, d, n);
                  },
                  [&](const Cylinder& c) {
                    const Vec3& p = cells.local_positions[i];

@@ -71,6 +71,12 @@ struct CellSet {
   // (MagneticBody::pair_tensors).
   bool refined = false;
   std::vector<Vec3> cube_centres;
+  // A box's cells: per cell the half extents of its part of the box, a
+  // cuboid centred on the cell point (cube ∩ box about its centroid for
+  // volume-share cells; the layer of a thin box's centre-inside cells), or
+  // the cube of edge h where its part is no cuboid about the point. Empty for
+  // other bodies.
+  std::vector<Vec3> part_halves;
 
   int size() const { return static_cast<int>(local_positions.size()); }
   // Cells of their own sizes (graded or refined): per-pair intra-body
@@ -86,20 +92,47 @@ struct CellSet {
   Vec3 cube_half(int i) const {
     return half_extents.empty() ? Vec3{0.5 * spacing, 0.5 * spacing, 0.5 * spacing} : half_extents[i];
   }
+  // The uniformly magnetized solid cell i stands for in the fields between
+  // bodies and at field points (the near fields, probes): a cuboid centred on
+  // the cell point with these half extents, carrying the cell's moment over
+  // solid_volume. A box's part of the body (part_halves), a graded cell's
+  // cuboid, a refined cell's cube; otherwise the cube of edge h, with volume
+  // cell_volume (a curved body's boundary cell: its cube at its centroid with
+  // the reduced magnetization V_i M / h^3). For lattice cells (spacing > 0).
+  Vec3 solid_half(int i) const {
+    if (!part_halves.empty()) return part_halves[i];
+    return cube_half(i);
+  }
+  double solid_volume(int i) const {
+    if (!part_halves.empty() || graded) return volumes[i];
+    if (refined) {
+      const Vec3 a = cube_half(i);
+      return 8.0 * a.x * a.y * a.z;
+    }
+    return cell_volume;
+  }
+  // True when cell i's solid is the cube of edge h (solid_half h/2).
+  bool solid_is_cube(int i) const {
+    if (graded || refined) return false;
+    if (part_halves.empty()) return true;
+    const Vec3& p = part_halves[i];
+    return p.x == 0.5 * spacing && p.y == 0.5 * spacing && p.z == 0.5 * spacing;
+  }
 };
 
 // Cells of a shape on a lattice of spacing h = cell_size (docs/model.md
 // "Cells"). With cell_size <= 0 the body is one cell at its centre, standing
-// for the whole body. Curved bodies (balls, cylinders) at least
-// kMinVolumeShareExtent h across along every axis get volume-share cells: per
-// axis ceil(extent / h) points spaced h apart and centred on the body (so the
-// cubes cover it), and every cube with a share of its volume inside the shape
-// above kMinCellShare is a cell, standing for that part at its centroid.
-// Boxes, and bodies thinner than that, keep centre-inside cells: per axis
-// max(1, floor(extent / h)) points, those inside the shape are cells standing
-// for volume / N each (h^3 for boxes whose edges are multiples of h); a
-// lattice coarser than the body gives one cell at the centre.
-CellSet make_cells(const Shape& shape, double cell_size);
+// for the whole body. Bodies of fixed magnetization, and responsive bodies at
+// least kMinVolumeShareExtent h across along every axis, get volume-share
+// cells: per axis ceil(extent / h) points spaced h apart and centred on the
+// body (so the cubes cover it), and every cube with a share of its volume
+// inside the shape above kMinCellShare is a cell, standing for that part at
+// its centroid (a box's parts are cuboids: CellSet::part_halves). Thinner
+// responsive bodies keep centre-inside cells: per axis max(1, floor(extent /
+// h)) points, those inside the shape are cells standing for volume / N each;
+// a lattice coarser than the body gives one cell at the centre.
+// responsive: the body's magnetization responds to fields (soft, recoil).
+CellSet make_cells(const Shape& shape, double cell_size, bool responsive = true);
 
 // Graded cells of a box (docs/model.md "Graded cells"): per axis n =
 // floor(edge / h) cells (as make_cells) whose faces lie at the
@@ -151,12 +184,12 @@ inline constexpr int kMinGradedExtent = 4;
 inline constexpr int kMaxGradedCells = 1000;
 
 // True when make_cells gives the shape volume-share cells.
-bool uses_volume_shares(const Shape& shape, double cell_size);
+bool uses_volume_shares(const Shape& shape, double cell_size, bool responsive = true);
 
 // Cubes with less than this share of their volume inside the shape are left
 // out (their volume, at most this share of h^3 each, is lost).
 inline constexpr double kMinCellShare = 1e-9;
-// Extent (in cells, every axis) from which a curved body has volume-share cells.
+// Extent (in cells, every axis) from which a responsive body has volume-share cells.
 inline constexpr double kMinVolumeShareExtent = 2.0;
 
 // The demagnetising tensor of the uniformly magnetized shape, averaged over

@@ -288,7 +288,8 @@ MagneticBody MagneticModel::make_body(const std::string& name, const Shape& shap
       throw std::invalid_argument("body \"" + name + "\": " + e.what());
     }
   } else if (!is_inert(material)) {
-    body.cells = graded ? make_graded_box_cells(shape, cell_size) : make_cells(shape, cell_size);
+    body.cells = graded ? make_graded_box_cells(shape, cell_size)
+                        : make_cells(shape, cell_size, has_positive_susceptibility(material));
   }
 
   if (const auto* pm = std::get_if<PermanentMaterial>(&material)) {

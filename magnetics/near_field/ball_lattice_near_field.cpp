@@ -370,11 +370,10 @@ struct LatticeBody {
   int body = -1;
   double h = 0.0;
   double volume = 0.0;  // V of T_c for a cube cell (CellSet::cell_volume)
-  const Box* box = nullptr;  // a box body's shape: its cells' parts are cuboids
   Vec3 local_centroid;  // of the cell points, body frame
   double radius = 0.0;  // bounding sphere about it
   Eigen::Matrix3d local_J_inverse = Eigen::Matrix3d::Zero();  // body frame
-  std::vector<Vec3> half;         // per cell: half extents of its solid (cell_solid)
+  std::vector<Vec3> half;         // per cell: half extents of its solid (CellSet::solid_half)
   std::vector<double> solid_volume;  // per cell: V of T_c
   bool shared = false;            // corners shares the cells' corner terms
   SharedCorners corners;
@@ -642,7 +641,6 @@ class BallLatticeNearField final : public NearFieldTerm {
       lb.body = bi;
       lb.h = body.cells.spacing;
       lb.volume = body.cells.cell_volume;
-      lb.box = std::get_if<Box>(&body.shape);
       const std::vector<Vec3>& x = body.cells.local_positions;
       for (const Vec3& xi : x) lb.local_centroid += xi;
       lb.local_centroid = lb.local_centroid / body.cell_count();
@@ -658,11 +656,9 @@ class BallLatticeNearField final : public NearFieldTerm {
       lb.local_J_inverse = J.inverse();
       std::vector<Vec3> lower, upper;
       for (int i = 0; i < body.cell_count(); ++i) {
-        Vec3 half;
-        double volume;
-        cell_solid(model, lb, body.first_cell + i, half, volume);
+        const Vec3 half = body.cells.solid_half(i);
         lb.half.push_back(half);
-        lb.solid_volume.push_back(volume);
+        lb.solid_volume.push_back(body.cells.solid_volume(i));
         lower.push_back(x[i] - half);
         upper.push_back(x[i] + half);
       }
@@ -670,27 +666,6 @@ class BallLatticeNearField final : public NearFieldTerm {
       cached_.push_back(std::move(lb));
     }
     groups_.assign(static_cast<std::size_t>(model.body_count()) * cached_.size(), {});
-  }
-
-  // The solid a cell's field comes from: in a box body its part of the body,
-  // the cuboid centred on its cell point (the part's centroid) with extents
-  // e_k = min(h, 2 (L_k/2 - |c_k|)) (a boundary cell's part reaches the box's
-  // face), magnetization mu / V_i; otherwise its cube, mu / cell_volume.
-  static void cell_solid(const MagneticModel& model, const LatticeBody& lb, int c, Vec3& half, double& volume) {
-    const double h = lb.h;
-    half = {0.5 * h, 0.5 * h, 0.5 * h};
-    volume = lb.volume;
-    if (!lb.box) return;
-    const MagneticBody& body = model.body(lb.body);
-    const Vec3& x = body.cells.local_positions[c - body.first_cell];
-    Vec3 e;
-    for (int k = 0; k < 3; ++k) e[k] = std::min(h, 2.0 * (0.5 * lb.box->size[k] - std::fabs(x[k])));
-    const double V = model.cell_volume(c);
-    // Only where the extents account for the part's volume (a lattice whose
-    // cells are not cuboid parts of the box keeps the cube).
-    if (!(e.x > 0.0 && e.y > 0.0 && e.z > 0.0) || std::fabs(e.x * e.y * e.z - V) > 1e-6 * V) return;
-    half = 0.5 * e;
-    volume = V;
   }
 
   std::vector<Ball> balls_;

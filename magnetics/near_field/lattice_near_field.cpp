@@ -227,6 +227,48 @@ void cube_pair_tensor(const double d[3], double h, double volume, double D[6], d
   }
 }
 
+// The tensor of two aligned cuboid solids (half extents a of the target, b
+// of the source, CellSet::solid_half) acting on moments, H = D mu, at the
+// offset d of their centres: D = -(N_ab - S / V_a) / V_b with N_ab the
+// cuboid-cuboid tensor (cuboid_demag_tensor), V the solids' volumes and S the
+// smoothed onset of overlap of cube_pair_tensor with the overlaps p_k = a_k +
+// b_k - |d_k| (at most 2 min(a_k, b_k)), so that V_a V_b D is symmetric in
+// the two cells; and, when dD is not null, dD[k] = dD / dd_k. A box's
+// boundary cells are such cuboids: its face's charge sits on the face.
+void solid_pair_tensor(const double d[3], const double a[3], const double b[3], double h, double D[6],
+                       double (*dD)[6]) {
+  double n[6], dn[3][6];
+  cuboid_demag_tensor(a, b, d, n, dD ? dn : nullptr);
+  const double Va = 8.0 * a[0] * a[1] * a[2], Vb = 8.0 * b[0] * b[1] * b[2];
+  double p[3], dp[3];
+  for (int k = 0; k < 3; ++k) {
+    const double s = std::fabs(d[k]), reach = a[k] + b[k], full = 2.0 * std::min(a[k], b[k]);
+    const double sign = d[k] > 0.0 ? 1.0 : (d[k] < 0.0 ? -1.0 : 0.0);
+    p[k] = std::clamp(reach - s, 0.0, full);
+    dp[k] = (s < reach && reach - s < full) ? -sign : 0.0;
+  }
+  double q[3], dq[3];
+  for (int k = 0; k < 3; ++k) q[k] = edge_ramp(p[k], kEdgeWidth * h, dq[k]), dq[k] *= dp[k];
+  double s[3] = {}, ds[3][3] = {};
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    double dD_dp;
+    const double o = onset(p[k], kOnsetWidth * h, dD_dp);
+    if (o == 0.0 && dD_dp == 0.0) continue;
+    s[k] = o * q[i] * q[j];
+    ds[k][k] = dD_dp * dp[k] * q[i] * q[j];
+    ds[k][i] = o * dq[i] * q[j];
+    ds[k][j] = o * q[i] * dq[j];
+  }
+  for (int m = 0; m < 6; ++m) D[m] = -n[m] / Vb;
+  for (int k = 0; k < 3; ++k) D[kDiagonal[k]] += s[k] / (Va * Vb);
+  if (!dD) return;
+  for (int m = 0; m < 3; ++m) {
+    for (int c = 0; c < 6; ++c) dD[m][c] = -dn[m][c] / Vb;
+    for (int k = 0; k < 3; ++k) dD[m][kDiagonal[k]] += ds[k][m] / (Va * Vb);
+  }
+}
+
 // The volume that turns the cube tensor into one on moments, H = -N mu / V:
 // the one the body's own tensors use, as inside a body (CellSet::cell_volume:
 // h^3 for volume-share cells and boxes of whole cells, where a boundary cell
@@ -244,12 +286,35 @@ struct LocalTensor {
   double dD[3][6];
 };
 
-LocalTensor local_tensor(const Mat3& R, const Vec3& d, double h, double volume) {
+// The cells' solids in one body frame: both the cube of edge h (cubes), or
+// their half extents in that frame.
+struct PairSolids {
+  bool cubes = true;
+  Vec3 half_i, half_j;
+};
+
+LocalTensor local_tensor(const Mat3& R, const Vec3& d, double h, double volume, const PairSolids& solids) {
   LocalTensor t;
   const Vec3 dl = R.transpose_times(d);
   const double local[3] = {dl.x, dl.y, dl.z};
-  cube_pair_tensor(local, h, volume, t.D, t.dD);
+  if (solids.cubes) {
+    cube_pair_tensor(local, h, volume, t.D, t.dD);
+  } else {
+    const double a[3] = {solids.half_i.x, solids.half_i.y, solids.half_i.z};
+    const double b[3] = {solids.half_j.x, solids.half_j.y, solids.half_j.z};
+    solid_pair_tensor(local, a, b, h, t.D, t.dD);
+  }
   return t;
+}
+
+// Half extents given in one lattice's frame, in the other's: components
+// permuted as the signed permutation P (x_A = P x_B) maps the axes.
+Vec3 permuted_half(const Mat3& P, const Vec3& half) {
+  Vec3 out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      if (P.m[r][c] != 0.0) out[r] = half[c];
+  return out;
 }
 
 // One body frame's share of a pair, given the moments: phi = mu_i . T_X mu_j
@@ -299,6 +364,7 @@ struct CellPair {
   // offset d they were computed at.
   Vec3 d;
   double volume = 0.0;
+  PairSolids solids_a, solids_b;  // in body a's and body b's frames
   LocalTensor frame_a, frame_b;
 };
 
@@ -382,8 +448,8 @@ class LatticeNearField final : public NearFieldTerm {
                               d.x == p.d.x && d.y == p.d.y && d.z == p.d.z;
       LocalTensor ta, tb;
       if (!built_here) {
-        ta = local_tensor(Ra, d, l.h, p.volume);
-        tb = same_rotation(Ra, Rb) ? ta : local_tensor(Rb, d, l.h, p.volume);
+        ta = local_tensor(Ra, d, l.h, p.volume, p.solids_a);
+        tb = same_rotation(Ra, Rb) ? ta : local_tensor(Rb, d, l.h, p.volume, p.solids_b);
       }
       const FrameShare A = frame_share(Ra, built_here ? p.frame_a : ta, mu_i, mu_j);
       const FrameShare B = frame_share(Rb, built_here ? p.frame_b : tb, mu_i, mu_j);
@@ -486,8 +552,13 @@ class LatticeNearField final : public NearFieldTerm {
         p.i = i, p.j = j, p.link = link_index;
         p.d = d;
         p.volume = pair_volume(model, i, j);
-        p.frame_a = local_tensor(Ra, d, h, p.volume);
-        p.frame_b = link.same_frames ? p.frame_a : local_tensor(Rb, d, h, p.volume);
+        const CellSet &ca = A.cells, &cb = B.cells;
+        const int ia = i - A.first_cell, jb = j - B.first_cell;
+        const bool cubes = ca.solid_is_cube(ia) && cb.solid_is_cube(jb);
+        p.solids_a = {cubes, ca.solid_half(ia), permuted_half(P, cb.solid_half(jb))};
+        p.solids_b = {cubes, permuted_half(P.transposed(), ca.solid_half(ia)), cb.solid_half(jb)};
+        p.frame_a = local_tensor(Ra, d, h, p.volume, p.solids_a);
+        p.frame_b = link.same_frames ? p.frame_a : local_tensor(Rb, d, h, p.volume, p.solids_b);
         double ta[6], tb[6];
         rotate_symmetric(Ra, p.frame_a.D, ta);
         rotate_symmetric(Rb, p.frame_b.D, tb);

@@ -396,6 +396,30 @@ TEST(Timeline, EventsAtTimeZeroHoldBeforeTheFirstStep) {
   EXPECT_NEAR(body_moment(system.model, system.state, 1).z, 3.0 * V * 1000.0, 0.01 * 3.0 * V * 1000.0);
 }
 
+// Zones that would give a ball more than kMaxRefinedCells cells: the ball
+// keeps its plain cells, and the scene's notices name it and the cap.
+TEST(Simulation, ContactZonesBeyondTheCapLeaveThePlainCellsWithANotice) {
+  SceneDescription s;
+  s.file = "big";
+  s.materials["iron"] = test_support::steel();
+  for (const auto& [name, z] : {std::pair{"a", 0.0}, std::pair{"b", 0.0101}}) {
+    s.bodies.push_back(body(name, Sphere{0.005}, "iron", {0.0, 0.0, z}));
+    s.bodies.back().cell_size = 0.0005;
+  }
+  ASSERT_TRUE(s.solver.contact_refinement);  // the default
+  const std::vector<std::vector<RefinedZone>> zones = scene_contact_zones(s);
+  EXPECT_TRUE(zones[0].empty());
+  EXPECT_TRUE(zones[1].empty());
+  const std::vector<std::string> notices = scene_notices(s);
+  ASSERT_EQ(notices.size(), 2u);
+  EXPECT_NE(notices[0].find("bodies[0]"), std::string::npos) << notices[0];
+  EXPECT_NE(notices[0].find("4000"), std::string::npos) << notices[0];
+  // At R/h 4.5 the zones fit.
+  for (BodyDescription& b : s.bodies) b.cell_size = 0.005 / 4.5;
+  EXPECT_FALSE(scene_contact_zones(s)[0].empty());
+  EXPECT_TRUE(scene_notices(s).empty());
+}
+
 // Refined contact zones follow the contacts (docs/model.md "Refined contact
 // zones"): a lattice ball that slides over another at 3 m/s has its contact
 // point move by 1.4 mm and 1.2 mm in the first two steps, in both balls'

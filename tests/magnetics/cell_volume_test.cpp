@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -46,18 +47,18 @@ double depth(const Shape& shape, const Vec3& p) {
   return std::min(c.radius - std::hypot(p.x, p.y), 0.5 * c.length - std::fabs(p.z));
 }
 
-// 1. Boxes, and bodies under two cells across, keep centre-inside cells: at
-// the lattice sites, floor(extent / h) per axis, each standing for volume / N
-// (h^3 for boxes whose edges are multiples of h), no boundary correction.
-TEST(CellVolume, BoxesAndThinBodiesKeepCentreInsideCells) {
+// 1. Responsive bodies under two cells across along some axis keep
+// centre-inside cells: at the lattice sites, floor(extent / h) per axis, each
+// standing for volume / N, no boundary correction; a box's cells then stand
+// for their parts where they tile it (one layer of a sheet: the layer).
+TEST(CellVolume, ThinResponsiveBodiesKeepCentreInsideCells) {
   for (const auto& [shape, h] : std::vector<std::pair<Shape, double>>{
-           {Box{{0.01, 0.02, 0.005}}, 0.0025},
-           {Box{{0.03, 0.01, 0.01}}, 0.005},
-           {Box{{0.0105, 0.02, 0.0049}}, 0.002},   // edges not multiples of h: 5 x 10 x 2 cells
+           {Box{{0.0105, 0.02, 0.0049}}, 0.0025},  // 1.96 cells thick
            {Box{{0.075, 0.035, 0.001}}, 0.005},    // a sheet thinner than h: one layer
            {Cylinder{0.0015, 0.05}, 0.0025},       // a nail 1.2 cells across: one column
            {Sphere{0.01}, 0.0105}}) {              // a ball 1.9 cells across
     EXPECT_FALSE(uses_volume_shares(shape, h)) << shape_kind(shape);
+    EXPECT_TRUE(uses_volume_shares(shape, h, false)) << shape_kind(shape) << ": fixed magnetization";
     const CellSet c = make_cells(shape, h);
     const Vec3 half = shape_half_extents(shape);
     int lattice_points = 1;
@@ -85,6 +86,54 @@ TEST(CellVolume, BoxesAndThinBodiesKeepCentreInsideCells) {
     model.add_body("body", shape, iron, h);
     EXPECT_TRUE(model.body(0).self_tensors.empty());
     EXPECT_TRUE(model.body(0).uniform_tensors.empty());
+  }
+  // The sheet's cells stand for their layer of it: 5 x 5 x 1 mm cuboids.
+  const CellSet sheet = make_cells(Box{{0.075, 0.035, 0.001}}, 0.005);
+  for (int i = 0; i < sheet.size(); ++i) {
+    EXPECT_NEAR(sheet.solid_half(i).x, 0.0025, 1e-15);
+    EXPECT_NEAR(sheet.solid_half(i).z, 0.0005, 1e-15);
+    EXPECT_NEAR(sheet.solid_volume(i), 2.5e-8, 1e-22);
+  }
+}
+
+// 1b. Boxes at least two cells across, and bodies of fixed magnetization at
+// any size, get volume-share cells: ceil(extent / h) per axis, centred, the
+// cubes covering the body; a box's boundary cells are the cuboids cube ∩ box
+// (volume, centroid and solid exact), so the body keeps its whole volume
+// where it was at every cell size (a 20 x 10 x 4.9 mm box at h = 2 mm: the
+// lattice of centre-inside cells covered 16 x 8 x 4 mm).
+TEST(CellVolume, BoxesGetTheirPartsAtEveryCellSize) {
+  for (const auto& [size, h, responsive] : std::vector<std::tuple<Vec3, double, bool>>{
+           {{0.01, 0.02, 0.005}, 0.0025, true},   // whole cubes
+           {{0.0105, 0.02, 0.0049}, 0.002, true},  // 5.25 x 10 x 2.45 cells
+           {{0.02, 0.01, 0.005}, 0.01 / 3.0, false},  // a magnet 1.5 cells thick
+           {{0.075, 0.035, 0.001}, 0.005, false}}) {  // a magnet sheet
+    const Box box{size};
+    ASSERT_TRUE(uses_volume_shares(box, h, responsive));
+    const CellSet c = make_cells(box, h, responsive);
+    double volume = 0.0;
+    Vec3 first_moment;
+    bool whole = true;
+    for (int i = 0; i < c.size(); ++i) {
+      const Vec3 s = lattice_site(c, i), half = c.solid_half(i), p = c.local_positions[i];
+      Vec3 lo, hi;
+      for (int a = 0; a < 3; ++a) {  // the cube ∩ box, written here
+        lo[a] = std::max(s[a] - 0.5 * h, -0.5 * size[a]);
+        hi[a] = std::min(s[a] + 0.5 * h, 0.5 * size[a]);
+        EXPECT_NEAR(half[a], 0.5 * (hi[a] - lo[a]), 1e-15) << i;
+        EXPECT_NEAR(p[a], 0.5 * (lo[a] + hi[a]), 1e-15) << i;
+      }
+      const double v = (hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z);
+      EXPECT_NEAR(c.volumes[i], v, 1e-12 * v) << i;
+      EXPECT_NEAR(c.solid_volume(i), v, 1e-12 * v) << i;
+      whole = whole && std::fabs(v - h * h * h) <= 1e-12 * h * h * h;
+      volume += c.volumes[i];
+      first_moment += c.volumes[i] * p;
+    }
+    const double V = size.x * size.y * size.z;
+    EXPECT_NEAR(volume, V, 1e-12 * V);
+    EXPECT_NEAR(norm(first_moment) / V, 0.0, 1e-15);  // centred
+    EXPECT_EQ(c.whole_cells, whole);
   }
 }
 

@@ -34,7 +34,7 @@ rng = random.Random(args.seed)
 R = 0.005                  # ball radius, m
 heap_half = 0.065          # half width of the balls' first layer, m
 crane = [0.12, 0.12, 0.03]  # crane magnet (box), m
-h_crane = 0.012            # its lattice spacing: 10 x 10 x 2 = 200 cells
+h_crane = 0.015            # its lattice spacing: 8 x 8 x 2 = 128 whole cubes of the 120 x 120 x 30 mm core
 # --electromagnet: the winding around the core, a rounded-rectangle coil from
 # 2 mm to 42 mm off the core's sides (40 mm radial build), 60 mm tall, its
 # lower end flush with the core's pole face (it stands 30 mm above the core's
