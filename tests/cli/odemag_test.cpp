@@ -713,7 +713,7 @@ TEST_F(Cli, RerunIntoTheSameOutReplacesThePreviousRunsFiles) {
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"notes.txt", "state.jsonl", "summary.json"}));
+  EXPECT_EQ(names, (std::vector<std::string>{".odemag.lock", "notes.txt", "state.jsonl", "summary.json"}));
   EXPECT_EQ(lines(read_file(out / "state.jsonl")).size(), 2u);
 }
 
