@@ -14,19 +14,9 @@
 #include "magnetics/model/model.h"
 #include "magnetics/kernels/rng.h"
 #include "magnetics/model/state.h"
+#include "magnetics/relax/threads.h"
 
 namespace odemag::bench {
-
-// Runs the program again with OMP_WAIT_POLICY=passive when that is unset:
-// sleeping instead of spinning OpenMP threads, since on a machine shared with
-// other jobs spinning barriers slow small two-thread runs many times
-// (docs/benchmarks.md "Threads and waiting").
-inline void restart_with_passive_omp(char** argv) {
-  if (!std::getenv("OMP_WAIT_POLICY")) {
-    setenv("OMP_WAIT_POLICY", "passive", 1);
-    execv("/proc/self/exe", argv);
-  }
-}
 
 // The value of command-line option argv[i] (argv[i + 1], and i moves on to
 // it); when the option is last, says "<program>: <option> needs a value" and

@@ -228,7 +228,7 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::restart_with_passive_omp(argv);
+  odemag::restart_with_passive_omp_wait(argv);
   std::string out_dir = "benchmarks/results", layouts = "lattice,balls", thread_list = "1,2";
   int max_cells = 16384, fma_units = 0;
   double budget = 6.0, ghz = 0.0;

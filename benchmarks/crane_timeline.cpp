@@ -63,7 +63,7 @@ double dense_evaluation_ms(MagneticForces& magnetics) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::restart_with_passive_omp(argv);
+  odemag::restart_with_passive_omp_wait(argv);
   std::string scene_path = std::string(ODEMAG_SOURCE_DIR) + "/demos/scenes/crane.json", csv, label = "odemag";
   double duration = -1.0;
   int threads = 2, probe_every = 50, bin_steps = 10;

@@ -64,7 +64,7 @@ double process_cpu_s() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::restart_with_passive_omp(argv);
+  odemag::restart_with_passive_omp_wait(argv);
   std::string scene_path = std::string(ODEMAG_SOURCE_DIR) + "/demos/scenes/crane_small.json", snapshot,
               label = "window";
   double save_at = -1.0, scale = 0.0;

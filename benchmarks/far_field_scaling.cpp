@@ -65,7 +65,7 @@ struct Row {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::restart_with_passive_omp(argv);
+  odemag::restart_with_passive_omp_wait(argv);
   std::string out_dir = "benchmarks/results", theta_list = "0.3,0.5,0.7";
   int max_cells = 131072, max_exact = 16384, threads = 2;
   for (int i = 1; i < argc; ++i) {

@@ -256,7 +256,7 @@ Row make_row(const std::string& scene_name, const Config& c, const Replay& r, do
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::restart_with_passive_omp(argv);
+  odemag::restart_with_passive_omp_wait(argv);
   std::string out_dir = "benchmarks/results", scene_list = "iron_plate,thin_iron_plate,wood_plate,nail_and_balls,crane";
   int threads = 2, crane_steps = 100;
   double crane_start = 0.75, budget = 3.0;

@@ -109,7 +109,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::restart_with_passive_omp(argv);
+  odemag::restart_with_passive_omp_wait(argv);
   std::string out = "benchmarks/results";
   std::vector<std::string> hs = {"5", "2.5x2.5x5", "2.5"}, gradings;
   std::string graded_name = "team20_graded";

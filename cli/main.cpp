@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli/cli.h"
+#include "magnetics/relax/threads.h"
 #ifdef ODEMAG_WITH_RENDERER
 #include "render/scene_view.h"
 #endif
@@ -45,6 +46,7 @@ int dispatch(const std::string& command, const std::vector<std::string>& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  odemag::restart_with_passive_omp_wait(argv);  // docs/benchmarks.md "Threads and waiting"
   if (argc < 2) return usage_error("missing command; usage: odemag solve|field|run|sweep|help ... (see odemag --help)");
   const std::string command = argv[1];
   const std::vector<std::string> args(argv + 2, argv + argc);

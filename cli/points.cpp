@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli/cli.h"
+#include "odemag/constants.h"
 #include "odemag/scene.h"
 
 namespace odemag::cli {
@@ -95,6 +96,13 @@ std::vector<Vec3> parse_points(const std::string& text, const std::string& file)
     if (!ok)
       throw SceneError(file, "line " + std::to_string(line_number),
                        "expected three finite numbers x,y,z, got '" + excerpt(trim(raw)) + "'");
+    if (norm(p) > ranges::kLength.max) {
+      std::ostringstream bound;
+      bound << ranges::kLength.max;
+      throw SceneError(file, "line " + std::to_string(line_number),
+                       "the point '" + excerpt(trim(raw)) + "' is farther than the largest accepted length, " +
+                           bound.str() + " m, from the origin (docs/scene-format.md \"Ranges\")");
+    }
     points.push_back(p);
   }
   return points;

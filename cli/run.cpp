@@ -3,11 +3,13 @@
 // summary (docs/hard-cases.md "Output safety").
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -156,19 +158,80 @@ void check_output_directory(const std::filesystem::path& dir) {
   if (::access(dir.c_str(), W_OK) != 0) throw UsageError("--out " + dir.string() + ": the directory is not writable");
 }
 
-void prepare_output_directory(const std::filesystem::path& dir) {
+// The temporary files a run writes in --out and renames when complete
+// (render/png_writer.cpp: frame_NNNNN.png.tmp-XXXXXX from mkstemp;
+// write_file_atomically: summary.json.tmp-PID). A run killed while writing
+// one leaves it; the next run into the folder removes it.
+bool is_temporary_name(const std::string& name) {
+  const size_t at = name.find(".tmp-");
+  if (at == std::string::npos || at + 5 >= name.size()) return false;
+  const std::string final_name = name.substr(0, at), suffix = name.substr(at + 5);
+  if (is_frame_name(final_name))  // mkstemp's six characters
+    return suffix.size() == 6 && std::all_of(suffix.begin(), suffix.end(), [](char ch) {
+             return std::isalnum(static_cast<unsigned char>(ch)) != 0;
+           });
+  if (final_name == "summary.json")  // the writer's pid
+    return std::all_of(suffix.begin(), suffix.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
+  return false;
+}
+
+// The lock of an --out folder: DIR/.odemag.lock, held with flock(2) for the
+// whole run and holding the run's pid, so that a second run into a folder in
+// use is refused (exit 2) naming the first. The kernel releases the lock when
+// the run ends, however it ends (kill -9 too); the file stays.
+class OutputLock {
+ public:
+  explicit OutputLock(const std::filesystem::path& dir) {
+    const std::string path = (dir / kLockFile).string();
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw UsageError("--out " + dir.string() + ": cannot create " + path + ": " + std::strerror(errno));
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      char holder[32] = {};
+      const ssize_t n = ::pread(fd_, holder, sizeof holder - 1, 0);
+      ::close(fd_);
+      if (err != EWOULDBLOCK)
+        throw UsageError("--out " + dir.string() + ": cannot lock " + path + ": " + std::strerror(err));
+      std::string pid = n > 0 ? std::string(holder, static_cast<size_t>(n)) : "";
+      while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
+      throw UsageError("--out " + dir.string() + ": another odemag run (pid " + (pid.empty() ? "unknown" : pid) +
+                       ") is writing into this folder; wait for it to end or choose another --out");
+    }
+    const std::string pid = std::to_string(::getpid()) + "\n";
+    if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, pid.data(), pid.size(), 0) != static_cast<ssize_t>(pid.size()))
+      throw std::runtime_error("--out " + dir.string() + ": cannot write " + path + ": " + std::strerror(errno));
+  }
+  ~OutputLock() {
+    if (fd_ >= 0) ::close(fd_);  // releases the lock
+  }
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+
+  static constexpr const char* kLockFile = ".odemag.lock";
+
+ private:
+  int fd_ = -1;
+};
+
+// Creates --out, takes its lock and removes a previous run's files and the
+// temporary files of an interrupted one (nothing else).
+std::unique_ptr<OutputLock> prepare_output_directory(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw UsageError("--out " + dir.string() + ": cannot create the directory: " + ec.message());
+  auto lock = std::make_unique<OutputLock>(dir);
   std::vector<fs::path> previous;
-  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
-    if (is_frame_name(e.path().filename().string()) && e.is_regular_file(ec)) previous.push_back(e.path());
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if ((is_frame_name(name) || is_temporary_name(name)) && e.is_regular_file(ec)) previous.push_back(e.path());
+  }
   for (const char* name : kRunFiles)
     if (fs::exists(dir / name, ec)) previous.push_back(dir / name);
   for (const fs::path& p : previous)
     if (!fs::remove(p, ec) || ec)
       throw std::runtime_error("cannot remove the previous run's " + p.string() + ": " + ec.message());
+  return lock;
 }
 
 // --video: the frames encoded by the ffmpeg program.
@@ -313,7 +376,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   const std::string backend_name = backend->name();
   Simulation sim(scene, std::move(backend));
 
-  prepare_output_directory(dir);
+  const std::unique_ptr<OutputLock> lock = prepare_output_directory(dir);
   std::unique_ptr<FrameWriter> frame_writer;
   if (want_frames && frames) frame_writer = frames(scene);
   if (want_frames && !frame_writer)

@@ -439,10 +439,35 @@ int write_slurm(const SweepCommandLine& c, const CheckedSweep& cs) {
   return 0;
 }
 
+// --out checked before anything is written, as `odemag run` checks its own
+// (exit 2): a folder, or a path that can be made one (its nearest existing
+// ancestor a writable folder); --gather reads what the other steps wrote there,
+// so its folder must exist.
+void check_sweep_output(const SweepCommandLine& c) {
+  std::error_code ec;
+  const fs::path out = fs::absolute(c.out, ec).lexically_normal();
+  const std::string where = "--out " + c.out + ": ";
+  if (fs::exists(fs::status(out, ec))) {
+    if (!fs::is_directory(out, ec)) throw UsageError(where + "exists and is not a directory");
+    if (::access(out.c_str(), W_OK) != 0) throw UsageError(where + "the directory is not writable");
+    return;
+  }
+  if (c.mode == SweepCommandLine::Mode::gather)
+    throw UsageError(where + "no such directory (--gather reads the variants that --expand and --variant wrote there)");
+  fs::path ancestor = out.parent_path();
+  while (!ancestor.empty() && !fs::exists(fs::status(ancestor, ec)) && ancestor != ancestor.root_path())
+    ancestor = ancestor.parent_path();
+  if (!fs::is_directory(ancestor, ec))
+    throw UsageError(where + "cannot be created: " + ancestor.string() + " is not a directory");
+  if (::access(ancestor.c_str(), W_OK) != 0)
+    throw UsageError(where + "cannot be created: " + ancestor.string() + " is not writable");
+}
+
 }  // namespace
 
 int run_sweep(const std::vector<std::string>& args, const FrameWriterFactory& frames) {
   const SweepCommandLine c = parse_sweep_command(args);
+  check_sweep_output(c);
   if (c.mode == SweepCommandLine::Mode::dask) {
     load_sweep(c.spec);  // a bad spec is named here, exit 2, before Python starts
     return run_dask(c);

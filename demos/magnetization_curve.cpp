@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "cli/cli.h"
+#include "magnetics/relax/threads.h"
 #include "magnetics/relax/relax.h"
 
 extern char** environ;
@@ -162,6 +163,7 @@ int write_curves(const std::filesystem::path& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  odemag::restart_with_passive_omp_wait(argv);  // docs/benchmarks.md "Threads and waiting"
   return cli::program_main("demo_magnetization_curve", kUsage, {argv + 1, argv + argc}, {},
                            [](const cli::Arguments& a) { return write_curves(output_directory(a)); });
 }

@@ -15,6 +15,7 @@
 
 #include "render/scene_view.h"
 #include "cli/cli.h"
+#include "magnetics/relax/threads.h"
 
 namespace {
 
@@ -95,6 +96,7 @@ int run_scenes(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  odemag::restart_with_passive_omp_wait(argv);  // docs/benchmarks.md "Threads and waiting"
   return odemag::cli::program_main("demo_paper_scenes", kUsage, {argv + 1, argv + argc}, {"out", "only", "frames"},
                                    [](const odemag::cli::Arguments& a) { return run_scenes(read_options(a)); });
 }

@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the test suite with ctest.
+# Installs what is missing, builds everything (scripts/build.sh: the tests,
+# the benchmarks and the Python package too, also in a build/ that
+# scripts/demo.sh configured without them), and runs the test suite with ctest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh

@@ -5,7 +5,9 @@
 #include "magnetics/model/model.h"
 #include "magnetics/model/state.h"
 #include "magnetics/relax/relax.h"
+#include "odemag/constants.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -32,6 +34,33 @@ std::string format(const Mat3& m) {
   s << "[";
   for (int i = 0; i < 3; ++i) s << (i ? ", " : "") << format(Vec3{m.m[i][0], m.m[i][1], m.m[i][2]});
   s << "]";
+  return s.str();
+}
+
+// Why a rotation is not one (docs/embedding.md "Checks"): R^T R = I within
+// ranges::kRotationTolerance in every entry and det R > 0; "" when it is.
+std::string rotation_error(const Mat3& R) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double dot_ij = 0.0;
+      for (int k = 0; k < 3; ++k) dot_ij += R.m[k][i] * R.m[k][j];
+      if (std::abs(dot_ij - (i == j ? 1.0 : 0.0)) > ranges::kRotationTolerance) {
+        std::ostringstream why;
+        why << "is not orthonormal (entry (" << i << ", " << j << ") of R^T R is " << dot_ij << ", not within "
+            << ranges::kRotationTolerance << " of " << (i == j ? 1 : 0) << ")";
+        return why.str();
+      }
+    }
+  const double det = R.m[0][0] * (R.m[1][1] * R.m[2][2] - R.m[1][2] * R.m[2][1]) -
+                     R.m[0][1] * (R.m[1][0] * R.m[2][2] - R.m[1][2] * R.m[2][0]) +
+                     R.m[0][2] * (R.m[1][0] * R.m[2][1] - R.m[1][1] * R.m[2][0]);
+  if (!(det > 0.0)) return "is a reflection (det R = " + std::to_string(det) + "), not a rotation";
+  return "";
+}
+
+std::string format_number(double x) {
+  std::ostringstream s;
+  s << x;
   return s.str();
 }
 
@@ -105,10 +134,15 @@ Vec3 MagneticForces::torque(int index) const { return state_->torque[body_index(
 
 void MagneticForces::field_at_points(const std::vector<Vec3>& points, std::vector<Vec3>& B,
                                      std::vector<Vec3>& H) {
-  for (size_t p = 0; p < points.size(); ++p)
+  for (size_t p = 0; p < points.size(); ++p) {
     if (!is_finite(points[p]))
       throw std::invalid_argument("MagneticForces::field_at_points: point " + std::to_string(p) + " " +
                                   format(points[p]) + " is not finite");
+    if (norm(points[p]) > ranges::kLength.max)
+      throw std::invalid_argument("MagneticForces::field_at_points: point " + std::to_string(p) + " " +
+                                  format(points[p]) + " is farther than " + format_number(ranges::kLength.max) +
+                                  " m from the origin");
+  }
   odemag::field_at_points(*model_, *state_, *backend_, points, B, H);
 }
 
@@ -133,8 +167,15 @@ void MagneticForces::refine_body(int index, const std::vector<RefinedZone>& zone
 
 int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& material,
                            double cell_size, const std::string& name) {
-  const int index = model_->add_body(name.empty() ? "body" + std::to_string(model_->body_count()) : name,
-                                    shape, material, cell_size);
+  const int next = model_->body_count();
+  const std::string body_name = name.empty() ? "body" + std::to_string(next) : name;
+  int index = -1;
+  try {
+    index = model_->add_body(body_name, shape, material, cell_size);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("MagneticForces::attach: body " + std::to_string(next) + " \"" + body_name +
+                                "\": " + e.what());
+  }
   extend_state(*model_, *state_);
   bodies_.push_back(body);
   reference_force_.emplace_back();
@@ -221,6 +262,10 @@ void MagneticForces::restore_state(const SavedMagneticState& saved_state) {
 void MagneticForces::set_external_field(const Vec3& H) {
   if (!is_finite(H))
     throw std::invalid_argument("MagneticForces::set_external_field: the field " + format(H) + " is not finite");
+  if (norm(H) > ranges::kFieldStrength.max)
+    throw std::invalid_argument("MagneticForces::set_external_field: the field " + format(H) +
+                                " A/m is stronger than the largest accepted, " +
+                                format_number(ranges::kFieldStrength.max) + " A/m");
   state_->external_field = H;
 }
 
@@ -232,18 +277,37 @@ void MagneticForces::set_wake_tolerance(double tolerance) {
 
 void MagneticForces::set_magnetization_scale(int index, double scale) {
   const int b = body_index(index, "set_magnetization_scale");
-  if (!std::isfinite(scale))
-    throw std::invalid_argument("MagneticForces::set_magnetization_scale: the scale of body " +
-                                std::to_string(b) + " \"" + model_->body(b).name + "\" is not finite");
+  const std::string where = "MagneticForces::set_magnetization_scale: the scale " + format_number(scale) +
+                            " of body " + std::to_string(b) + " \"" + model_->body(b).name + "\"";
+  if (!std::isfinite(scale)) throw std::invalid_argument(where + " is not finite");
+  // The scene's rule for scale_magnetization events (odemag/constants.h).
+  const MagneticBody& body = model_->body(b);
+  const Vec3 field = body.kind == CellKind::soft ? body.coil_field : body.remanence;
+  double largest_ni = 0.0;
+  for (const AttachedCoil& k : model_->coils())
+    if (k.body == b) largest_ni = std::max(largest_ni, std::abs(ampere_turns(k.source)));
+  const double limit = ranges::largest_magnetization_scale(
+      std::max({std::abs(field.x), std::abs(field.y), std::abs(field.z)}), largest_ni);
+  if (std::abs(scale) > limit)
+    throw std::invalid_argument(where + " scales its magnetization or its coils' ampere-turns beyond the largest "
+                                "accepted, " + format_number(ranges::kFieldStrength.max) + " A/m and " +
+                                format_number(ranges::kAmpereTurns.max) + " A (at most " + format_number(limit) +
+                                " for this body)");
   state_->magnetization_scale[b] = scale;
 }
 
 void MagneticForces::set_pose(int index, const BodyPose& pose) {
   const int b = body_index(index, "set_pose");
+  const std::string where =
+      "MagneticForces::set_pose: the pose of body " + std::to_string(b) + " \"" + model_->body(b).name + "\"";
   if (!is_finite(pose.position) || !finite(pose.rotation))
-    throw std::invalid_argument("MagneticForces::set_pose: the pose of body " + std::to_string(b) + " \"" +
-                                model_->body(b).name + "\" is not finite (position " + format(pose.position) +
-                                ", rotation " + format(pose.rotation) + ")");
+    throw std::invalid_argument(where + " is not finite (position " + format(pose.position) + ", rotation " +
+                                format(pose.rotation) + ")");
+  if (norm(pose.position) > ranges::kLength.max)
+    throw std::invalid_argument(where + ": the position " + format(pose.position) + " is farther than " +
+                                format_number(ranges::kLength.max) + " m from the origin");
+  if (const std::string why = rotation_error(pose.rotation); !why.empty())
+    throw std::invalid_argument(where + ": the rotation " + format(pose.rotation) + " " + why);
   state_->pose[b] = pose;
 }
 

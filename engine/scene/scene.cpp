@@ -56,25 +56,11 @@ using json = nlohmann::json;
 // fails at once instead of building a million-level tree (docs/testing.md, fuzzing findings).
 constexpr size_t kMaxNesting = 64;
 
-// The largest magnitude a scene value of a kind may have (docs/scene-format.md
-// "Ranges"): far beyond anything physical, and small enough that every product
-// the model forms from it (moments M V, fields m / r^3, forces mu0 M^2 L^2,
-// masses rho V) stays finite. A magnetization of 1e160 A/m made moments whose
-// squares overflow: the relaxation failed instead of the loader naming the key.
-struct Magnitude {
-  double max = 0.0;  // 0: no bound
-  const char* unit = "";
-};
-constexpr Magnitude kFieldStrength{1e9, "A/m"};  // about 800 times the strongest magnets' 1.2e6 A/m
-constexpr Magnitude kLength{1e6, "m"};
-constexpr Magnitude kSpeed{1e8, "m/s"};
-constexpr Magnitude kAngularSpeed{1e8, "rad/s"};
-constexpr Magnitude kAcceleration{1e6, "m/s^2"};
-constexpr Magnitude kDensity{1e6, "kg/m^3"};
-constexpr Magnitude kCurrent{1e9, "A"};      // a coil's current; its ampere-turns N I are bounded by kAmpereTurns too
-constexpr Magnitude kAmpereTurns{1e9, "A"};  // |N I| of a coil: fields up to about kFieldStrength
-constexpr Magnitude kTurns{1e9, ""};
-constexpr Magnitude kAngle{1e6, "rad"};
+// The largest magnitude a scene value of a kind may have: odemag/constants.h
+// (docs/scene-format.md "Ranges"), shared with the controls of the APIs. A
+// magnetization of 1e160 A/m made moments whose squares overflow: the
+// relaxation failed instead of the loader naming the key.
+using namespace ranges;
 // A shape's radius, side or length is at least this (its volume must not
 // underflow to a zero moment), m.
 constexpr double kMinSize = 1e-9;
@@ -652,11 +638,15 @@ struct CoilTarget {
      t.source.field = r.size(x, p);                                                                \
    },                                                                                              \
    .required = true}
+#define COIL_WIRE_RADIUS                                                                       \
+  {.name = "wire_radius", .read = [](const SceneReader& r, const json& x, const std::string& p, auto& t) { \
+     t.source.wire_radius = r.size(x, p);                                                         \
+   }}
 #define COIL_QUADRATURE \
   {.name = "quadrature_order", .check = Check::integer, .slot = SLOT(source.quadrature_order), .lo = 1, .hi = 64}
 
-const KeyTable<CoilTarget<CircularLoop>> kLoopKeys = {COIL_TYPE, COIL_CENTRE, COIL_AXIS, COIL_SIZE("radius", radius),
-                                                      COIL_CURRENT, COIL_TURNS};
+const KeyTable<CoilTarget<CircularLoop>> kLoopKeys = {COIL_TYPE,    COIL_CENTRE, COIL_AXIS, COIL_SIZE("radius", radius),
+                                                      COIL_CURRENT, COIL_TURNS,  COIL_WIRE_RADIUS};
 const KeyTable<CoilTarget<Solenoid>> kSolenoidKeys = {
     COIL_TYPE, COIL_CENTRE, COIL_AXIS, COIL_SIZE("radius", radius),
     {.name = "length", .check = Check::non_negative, .slot = SLOT(source.length), .bound = kLength, .required = true},
@@ -691,7 +681,8 @@ const KeyTable<CoilTarget<StraightSegment>> kSegmentKeys = {
     {.name = "a", .check = Check::vec3, .slot = SLOT(source.a), .bound = kLength, .required = true},
     {.name = "b", .check = Check::vec3, .slot = SLOT(source.b), .bound = kLength, .required = true},
     COIL_CURRENT,
-    COIL_TURNS};
+    COIL_TURNS,
+    COIL_WIRE_RADIUS};
 const KeyTable<CoilTarget<Arc>> kArcKeys = {
     COIL_TYPE,
     COIL_CENTRE,
@@ -700,7 +691,8 @@ const KeyTable<CoilTarget<Arc>> kArcKeys = {
     {.name = "start", .check = Check::non_zero_vec3, .slot = SLOT(source.start)},
     {.name = "angle", .check = Check::number, .slot = SLOT(source.angle), .bound = kAngle, .required = true},
     COIL_CURRENT,
-    COIL_TURNS};
+    COIL_TURNS,
+    COIL_WIRE_RADIUS};
 
 #undef COIL_TYPE
 #undef COIL_CENTRE
@@ -709,6 +701,7 @@ const KeyTable<CoilTarget<Arc>> kArcKeys = {
 #undef COIL_TURNS
 #undef COIL_SIZE
 #undef COIL_QUADRATURE
+#undef COIL_WIRE_RADIUS
 
 template <class S>
 CoilSource read_coil_keys(const SceneReader& r, const json& v, const std::string& path,
@@ -1148,16 +1141,14 @@ const KeyTable<EventTarget> kScaleEventKeys = {
        const SoftMaterial* soft = std::get_if<SoftMaterial>(&material);
        const Vec3 scaled = permanent ? permanent->magnetization : soft ? soft->coil_field : Vec3{};
        const double largest = std::max({std::abs(scaled.x), std::abs(scaled.y), std::abs(scaled.z)});
-       if (largest > 0.0 && std::abs(t.e.value) > kFieldStrength.max / largest)
-         r.fail(p, "scales the magnetization beyond the largest accepted, " + format_number(kFieldStrength.max) +
-                       " A/m (at most " + format_number(kFieldStrength.max / largest) + " for this body)");
        // The scaled currents stay within kAmpereTurns.
-       for (const CoilSource& coil : t.body->coils) {
-         const double NI = std::abs(ampere_turns(coil));
-         if (std::abs(t.e.value) > kAmpereTurns.max / NI)
-           r.fail(p, "scales a coil's ampere-turns beyond the largest accepted, " + format_number(kAmpereTurns.max) +
-                         " A (at most " + format_number(kAmpereTurns.max / NI) + " for this body)");
-       }
+       double largest_ni = 0.0;
+       for (const CoilSource& coil : t.body->coils) largest_ni = std::max(largest_ni, std::abs(ampere_turns(coil)));
+       const double limit = largest_magnetization_scale(largest, largest_ni);
+       if (std::abs(t.e.value) > limit)
+         r.fail(p, "scales the magnetization or the coils' ampere-turns beyond the largest accepted, " +
+                       format_number(kFieldStrength.max) + " A/m and " + format_number(kAmpereTurns.max) +
+                       " A (at most " + format_number(limit) + " for this body)");
      },
      .required = true},
     kEventEndTime,

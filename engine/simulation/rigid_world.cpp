@@ -115,7 +115,8 @@ RigidWorld::RigidWorld(const SceneDescription& scene)
         const dGeomID g =
             w.kind == CollisionSolid::Kind::box
                 ? dCreateBox(space_, w.size.x + 2 * skin, w.size.y + 2 * skin, w.size.z + 2 * skin)
-                : dCreateCylinder(space_, w.size.x + skin, w.size.z + 2 * skin);
+            : w.kind == CollisionSolid::Kind::cylinder ? dCreateCylinder(space_, w.size.x + skin, w.size.z + 2 * skin)
+                                                       : dCreateCapsule(space_, w.size.x + skin, w.size.z);
         dGeomSetBody(g, b.body);
         dGeomSetOffsetPosition(g, w.centre.x, w.centre.y, w.centre.z);
         dMatrix3 R{};

@@ -1,5 +1,6 @@
 #include "engine/simulation/winding_solids.h"
 
+#include <algorithm>
 #include <cmath>
 #include <type_traits>
 #include <variant>
@@ -23,6 +24,13 @@ CollisionSolid box(const Vec3& centre, const Mat3& axes, const Vec3& size) {
   return {CollisionSolid::Kind::box, centre, axes, size};
 }
 
+// A capsule of `radius` about the segment p0 p1.
+CollisionSolid capsule(const Vec3& p0, const Vec3& p1, double radius) {
+  const CoilFrame f = frame_from_axis(p1 - p0);
+  return {CollisionSolid::Kind::capsule, 0.5 * (p0 + p1), from_columns(f.e1, f.e2, f.e3),
+          {radius, radius, norm(p1 - p0)}};
+}
+
 // Boxes that cover the annular sector r_in <= r <= r_out, theta0 <= theta <=
 // theta1 about `centre` in the plane of u and v (theta from u towards v),
 // |w| <= height / 2: per box of half angle delta, along its mid direction
@@ -40,6 +48,23 @@ void add_sector_boxes(const Vec3& centre, const Vec3& u, const Vec3& v, const Ve
     const Vec3 across = -std::sin(theta) * u + std::cos(theta) * v;
     out.push_back(box(centre + (0.5 * (inner + r_out)) * radial, from_columns(radial, across, w),
                       {r_out - inner, 2.0 * r_out * std::sin(delta), height}));
+  }
+}
+
+// Capsules of radius `wire` (widened by the chords' sagitta) along the arc
+// of radius r about `centre` in the plane of u and v, from theta0 through
+// `angle` (either sign); angle 2 pi: a loop. kMaxWireCapsulesPerTurn.
+void add_wire_arc(const Vec3& centre, const Vec3& u, const Vec3& v, double r, double theta0, double angle,
+                  double wire, std::vector<CollisionSolid>& out) {
+  const double per_turn = std::clamp(std::ceil(kPi / std::acos(std::max(-1.0, 1.0 - wire / (4.0 * r)))), 24.0,
+                                     static_cast<double>(kMaxWireCapsulesPerTurn));
+  const int n = std::max(1, static_cast<int>(std::ceil(per_turn * std::abs(angle) / (2.0 * kPi) - 1e-9)));
+  const double step = angle / n, radius = wire + r * (1.0 - std::cos(0.5 * std::abs(step)));
+  for (int k = 0; k < n; ++k) {
+    const double t0 = theta0 + k * step, t1 = t0 + step;
+    const Vec3 p0 = centre + r * (std::cos(t0) * u + std::sin(t0) * v);
+    const Vec3 p1 = centre + r * (std::cos(t1) * u + std::sin(t1) * v);
+    out.push_back(capsule(p0, p1, radius));
   }
 }
 
@@ -62,6 +87,15 @@ std::vector<CollisionSolid> winding_solids(const CoilSource& coil) {
             add_sector_boxes(c.centre, u, v, w, c.inner_radius, c.outer_radius, 0.0, 2.0 * kPi,
                              c.length, out);
           }
+        } else if constexpr (std::is_same_v<T, CircularLoop>) {
+          const CoilFrame f = frame_from_axis(c.axis);
+          add_wire_arc(c.centre, f.e1, f.e2, c.radius, 0.0, 2.0 * kPi, filament_wire_radius(c), out);
+        } else if constexpr (std::is_same_v<T, Arc>) {
+          // Arc's frame (magnetics/sources/coil.cpp): e1 along start, turning about axis.
+          const CoilFrame f = frame_from_axis_and(c.axis, c.start);
+          add_wire_arc(c.centre, f.e1, f.e2, c.radius, 0.0, c.angle, filament_wire_radius(c), out);
+        } else if constexpr (std::is_same_v<T, StraightSegment>) {
+          out.push_back(capsule(c.a, c.b, filament_wire_radius(c)));
         } else if constexpr (std::is_same_v<T, RoundedRectangleCoil>) {
           // The coil's own frame (magnetics/sources/coil.h): u along width_direction, w along the axis.
           const CoilFrame f = frame_from_axis_and(c.axis, c.width_direction);

@@ -11,13 +11,22 @@
 // same frame; the posed overloads take a body pose (rotation body -> world,
 // position of the body frame's origin) and world points.
 //
-// On a conductor. The field of a filament (loop, segment, arc, the edge rings
-// of a solenoid sheet) diverges at the wire; at points closer to the wire than
-// kOnConductor times the source's size (radius, or segment length) the field
-// is returned as 0, the mean of the singular azimuthal field over a small
-// circle around the wire. On a solenoid sheet itself the field is the mean of
-// its two sides. Finite-section coils are finite everywhere, also inside the
-// copper.
+// Filaments have a wire. A loop, segment or arc stands for a round wire of
+// radius `wire_radius` (0: kDefaultWireRadius times the loop's or arc's radius
+// or the segment's length) carrying the current uniformly over its section.
+// Off the wire the field is the filament's, exact; inside it (distance d from
+// the wire's centre line below the wire radius a) it is the filament's times
+// (d / a)^2, the fraction of the current within d: for a straight wire
+// exactly the round conductor's H = N I d / (2 pi a^2), for loops and arcs the
+// same near the wire, with the curvature's smaller part scaled too
+// (docs/model.md "Current sources (coils)" gives the error against a thick
+// ring). So the field is continuous at the wire's surface and bounded
+// everywhere (at most about N I / (2 pi a)), and so is its gradient, which
+// the force on a magnetic body takes. A scene's filaments collide as
+// capsules of that radius (docs/simulation.md "Coil windings"). On a solenoid
+// sheet itself the field is the mean of its two sides; at points closer to
+// a sheet's edge ring than kOnConductor times its radius it is 0. Finite-section
+// coils are finite everywhere, also inside the copper.
 #pragma once
 
 #include <string>
@@ -27,8 +36,13 @@
 
 namespace odemag {
 
-// Distance from a filament, relative to its size, below which its field is 0.
+// Distance from a solenoid sheet's edge ring, relative to its radius, below
+// which its field is 0.
 inline constexpr double kOnConductor = 1e-10;
+
+// A filament's wire radius when its wire_radius is 0, relative to the loop's
+// or arc's radius or the segment's length.
+inline constexpr double kDefaultWireRadius = 0.01;
 
 // A circular filament of radius `radius` about `centre`, in the plane normal to `axis`.
 struct CircularLoop {
@@ -37,6 +51,7 @@ struct CircularLoop {
   double radius = 0.0;   // m
   double current = 0.0;  // A
   double turns = 1.0;
+  double wire_radius = 0.0;  // m; 0: kDefaultWireRadius * radius
 };
 
 // A straight filament; positive current flows from a to b.
@@ -44,6 +59,7 @@ struct StraightSegment {
   Vec3 a, b;
   double current = 0.0;
   double turns = 1.0;
+  double wire_radius = 0.0;  // m; 0: kDefaultWireRadius * |b - a|
 };
 
 // A circular arc: from centre + radius * start (start projected onto the
@@ -57,6 +73,7 @@ struct Arc {
   double angle = 0.0;  // rad, any value (|angle| > 2 pi winds more than once)
   double current = 0.0;
   double turns = 1.0;
+  double wire_radius = 0.0;  // m; 0: kDefaultWireRadius * radius
 };
 
 // A thin cylindrical current sheet (an ideal solenoid): `turns` turns spread
@@ -124,6 +141,10 @@ std::string coil_source_error(const CoilSource& source);
 
 // N I of a source (A).
 double ampere_turns(const CoilSource& source);
+
+// The wire radius of a filament (loop, segment, arc: its wire_radius, or the
+// default), m; 0 for the other sources.
+double filament_wire_radius(const CoilSource& source);
 
 // Field H (A/m) of a source at a point (same frame); B = mu0 H in vacuum.
 Vec3 coil_field_H(const CoilSource& source, const Vec3& point);

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "odemag/constants.h"
 #include "odemag/material.h"
 #include "odemag/settings.h"
 #include "odemag/shape.h"
@@ -104,9 +105,10 @@ class MagneticForces : public ForceAccumulator {
   // Attaches a shape (centred on the body's centre of mass, in its frame) and
   // a material to an ODE body and returns the magnetic body index. body may be
   // nullptr for a static body placed with set_pose. cell_size <= 0: one cell.
-  // Throws std::invalid_argument on a bad shape or material, or a lattice of
-  // more than kMaxBodyLatticePoints points (magnetics/model/model.h), before any
-  // cell is made.
+  // Throws std::invalid_argument naming the call and the body (the index and
+  // name it would get) on a bad shape or material, or a lattice of more than
+  // kMaxBodyLatticePoints points (magnetics/model/model.h), before any cell is
+  // made.
   int attach(dBodyID body, const Shape& shape, const Material& material, double cell_size = 0.0,
              const std::string& name = "");
   // The same with the material named `material` of a set of named materials,
@@ -149,7 +151,8 @@ class MagneticForces : public ForceAccumulator {
   // relaxation. add_forces() then adds them.
   void recompute_forces();
 
-  // Throws std::invalid_argument when H is not finite.
+  // Throws std::invalid_argument when H is not finite or stronger than
+  // ranges::kFieldStrength (odemag/constants.h).
   void set_external_field(const Vec3& H);
   Vec3 external_field() const;
   // Relative change of force or torque that wakes a sleeping body
@@ -162,12 +165,18 @@ class MagneticForces : public ForceAccumulator {
   // A body that is not active neither makes nor feels a field (removed).
   void set_active(int index, bool active);
   bool active(int index) const;
-  // Scales a permanent magnet's remanent magnetization (electromagnets, the
-  // crane). Throws std::invalid_argument when scale is not finite.
+  // Scales a permanent magnet's remanent magnetization, or an electromagnet's
+  // coil field and coil currents (the crane). Throws std::invalid_argument,
+  // naming the body, when scale is not finite or takes the magnetization
+  // beyond ranges::kFieldStrength or a coil's ampere-turns beyond
+  // ranges::kAmpereTurns (ranges::largest_magnetization_scale, the scene's
+  // rule for scale_magnetization events).
   void set_magnetization_scale(int index, double scale);
   double magnetization_scale(int index) const;
   // Pose of a static (body == nullptr) magnetic body. Throws
-  // std::invalid_argument when it is not finite.
+  // std::invalid_argument, naming the body, when it is not finite, the
+  // position is farther than ranges::kLength from the origin, or the rotation
+  // is not one (R^T R = I within ranges::kRotationTolerance, det R > 0).
   void set_pose(int index, const BodyPose& pose);
 
   RelaxOptions& options() { return options_; }
@@ -183,7 +192,7 @@ class MagneticForces : public ForceAccumulator {
   // B (T) and H (A/m) at world points (m) with the magnetization of the last
   // compute(); inside a magnetic body B = mu0 (H + M) with M of its nearest
   // cell. Throws std::invalid_argument naming the index of a point that is
-  // not finite.
+  // not finite or farther than ranges::kLength from the origin.
   void field_at_points(const std::vector<Vec3>& points, std::vector<Vec3>& B, std::vector<Vec3>& H);
 
   // Gives a body new refined contact zones (MagneticModel::refine_body,

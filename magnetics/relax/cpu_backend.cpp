@@ -9,6 +9,7 @@
 #include "magnetics/model/backend.h"
 #include "magnetics/model/cell_layout.h"
 #include "magnetics/relax/far_field.h"
+#include "magnetics/relax/threads.h"
 #include "magnetics/relax/field_probe.h"
 #include "magnetics/kernels/kernels.h"
 #include "magnetics/near_field/near_field.h"
@@ -59,7 +60,7 @@ struct CellArrays {
 
 class CpuBackend final : public MagneticBackend {
  public:
-  explicit CpuBackend(int threads) : threads_(threads > 0 ? threads : omp_get_max_threads()) {}
+  explicit CpuBackend(int threads) : threads_(threads > 0 ? threads : default_thread_count()) {}
 
   std::string name() const override { return "cpu"; }
 

@@ -433,6 +433,26 @@ Vec3 to_local(const CoilFrame& f, const Vec3& origin, const Vec3& point) {
 }
 Vec3 to_global(const CoilFrame& f, const Vec3& v) { return v.x * f.e1 + v.y * f.e2 + v.z * f.e3; }
 
+// Inside a filament's round wire of radius a (include/odemag/coil.h): the
+// filament's field times (d / a)^2, the part of the uniform current closer to
+// the centre line than the point (Ampere's law about a straight wire gives
+// H = N I d / (2 pi a^2)); 1 at and beyond the surface. distance2 = d^2.
+double inside_wire_factor(double distance2, double a) {
+  const double a2 = a * a;
+  return distance2 < a2 ? distance2 / a2 : 1.0;
+}
+
+// Closer to the centre line than kOnConductor a the field is 0: at most
+// ~kOnConductor N I / (2 pi a) there, and the filament's own formulas lose
+// their precision (they diverge on the line).
+bool on_centre_line(double distance2, double a) { return distance2 <= (kOnConductor * a) * (kOnConductor * a); }
+
+double wire_radius_of(const CircularLoop& s) { return s.wire_radius > 0.0 ? s.wire_radius : kDefaultWireRadius * s.radius; }
+double wire_radius_of(const Arc& s) { return s.wire_radius > 0.0 ? s.wire_radius : kDefaultWireRadius * s.radius; }
+double wire_radius_of(const StraightSegment& s) {
+  return s.wire_radius > 0.0 ? s.wire_radius : kDefaultWireRadius * norm(s.b - s.a);
+}
+
 bool finite(double v) { return std::isfinite(v); }
 bool finite(const Vec3& v) { return is_finite(v); }
 
@@ -559,7 +579,11 @@ Vec3 coil_field_H(const CircularLoop& loop, const Vec3& point) {
   const Cylindrical c = cylindrical(loop.centre, e3, point);
   double h_rho, h_z;
   loop_kernel(loop.radius, loop.current * loop.turns, c.rho, c.z, h_rho, h_z);
-  return h_rho * c.radial + h_z * e3;
+  const double distance2 = (c.rho - loop.radius) * (c.rho - loop.radius) + c.z * c.z;
+  const double wire = wire_radius_of(loop);
+  if (on_centre_line(distance2, wire)) return {};
+  const double inside = inside_wire_factor(distance2, wire);
+  return (inside * h_rho) * c.radial + (inside * h_z) * e3;
 }
 
 // Biot-Savart for a straight filament (Jackson problem 5.1; Purcell 6.3):
@@ -578,14 +602,16 @@ Vec3 coil_field_H(const StraightSegment& segment, const Vec3& point) {
   const double t1 = dot(r1, u), t2 = dot(r2, u);
   const Vec3 azimuth = cross(u, r1);  // |azimuth| = distance from the line
   const double d2 = squared_norm(azimuth);
+  // The distance from the segment (its nearest point: an end or the foot).
   const double distance2 = t1 <= 0.0 ? R1 * R1 : (t2 >= 0.0 ? R2 * R2 : d2);
-  if (distance2 <= (kOnConductor * length) * (kOnConductor * length)) return {};
+  const double wire = wire_radius_of(segment);
+  if (on_centre_line(distance2, wire)) return {};
   double f;
-  if (t1 > 0.0 && t2 < 0.0) {
-    f = (t1 / R1 - t2 / R2) / d2;
+  if (t1 > 0.0 && t2 < 0.0) {  // inside the wire d^2 / a^2 replaces 1 / d^2
+    f = (t1 / R1 - t2 / R2) / std::max(d2, wire * wire);
   } else {
     const double sum = R1 + R2;
-    f = 2.0 * length * sum / (R1 * R2 * (sum - length) * (sum + length));
+    f = inside_wire_factor(distance2, wire) * 2.0 * length * sum / (R1 * R2 * (sum - length) * (sum + length));
   }
   return (segment.current * segment.turns / (4.0 * kPi) * f) * azimuth;
 }
@@ -608,17 +634,18 @@ Vec3 coil_field_H(const Arc& arc, const Vec3& point) {
   const Vec3 local = to_local(f, arc.centre, point);
   const double rho = std::hypot(local.x, local.y), z = local.z;
   const double psi = rho > 0.0 ? std::atan2(local.y, local.x) : 0.0;
-  // On the wire?
+  // The distance from the arc (its nearest point: on the arc at the point's
+  // azimuth, or an end).
+  double distance2;
   {
     const double psi_positive = psi < 0.0 ? psi + 2.0 * kPi : psi;
-    double distance2;
     if (angle >= 2.0 * kPi || psi_positive <= angle) {
       distance2 = (rho - a) * (rho - a) + z * z;
     } else {
       const Vec3 start{a, 0.0, 0.0}, end{a * std::cos(angle), a * std::sin(angle), 0.0};
       distance2 = std::min(squared_norm(local - start), squared_norm(local - end));
     }
-    if (distance2 <= (kOnConductor * a) * (kOnConductor * a)) return {};
+    if (on_centre_line(distance2, wire_radius_of(arc))) return {};
   }
   const double phi1 = -psi, phi2 = angle - psi;
   const double q2 = (a + rho) * (a + rho) + z * z;
@@ -634,7 +661,8 @@ Vec3 coil_field_H(const Arc& arc, const Vec3& point) {
   const double d1 = std::sqrt(alpha2 + 4.0 * a * rho * s1 * s1), d2 = std::sqrt(alpha2 + 4.0 * a * rho * s2 * s2);
   const double cos_difference = 2.0 * std::sin(0.5 * (phi1 + phi2)) * std::sin(0.5 * (phi2 - phi1));
   const double is = 2.0 * cos_difference / (d1 * d2 * (d1 + d2));
-  const double scale = arc.current * arc.turns * a / (4.0 * kPi);
+  const double scale =
+      inside_wire_factor(distance2, wire_radius_of(arc)) * arc.current * arc.turns * a / (4.0 * kPi);
   const double h_rho = scale * z * ic, h_phi = scale * z * is, h_z = scale * (a * i0 - rho * ic);
   const double cp = std::cos(psi), sp = std::sin(psi);
   const Vec3 h_local{h_rho * cp - h_phi * sp, h_rho * sp + h_phi * cp, h_z};
@@ -773,6 +801,10 @@ std::string coil_source_error(const CoilSource& source) {
         if constexpr (std::is_same_v<T, CircularLoop> || std::is_same_v<T, Arc> || std::is_same_v<T, Solenoid>) {
           if (!(s.radius > 0.0) || !finite(s.radius)) why << "radius must be positive; ";
         }
+        if constexpr (std::is_same_v<T, CircularLoop> || std::is_same_v<T, Arc> ||
+                      std::is_same_v<T, StraightSegment>) {
+          if (!(s.wire_radius >= 0.0) || !finite(s.wire_radius)) why << "wire_radius must be >= 0 (0: the default); ";
+        }
         if constexpr (std::is_same_v<T, Arc>) {
           if (!finite(s.angle)) why << "angle must be finite; ";
           const Vec3 e3 = normalized(s.axis);
@@ -812,6 +844,18 @@ std::string coil_source_error(const CoilSource& source) {
 
 double ampere_turns(const CoilSource& source) {
   return std::visit([](const auto& s) { return s.current * s.turns; }, source);
+}
+
+double filament_wire_radius(const CoilSource& source) {
+  return std::visit(
+      [](const auto& s) -> double {
+        using T = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<T, CircularLoop> || std::is_same_v<T, Arc> || std::is_same_v<T, StraightSegment>)
+          return wire_radius_of(s);
+        else
+          return 0.0;
+      },
+      source);
 }
 
 // ---------------------------------------------------------------------------

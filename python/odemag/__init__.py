@@ -16,17 +16,32 @@ world frame. Per-body arrays have one row per scene body, in scene order
 # The bindings need the built extension odemag._core (build/python/odemag);
 # odemag.sweep needs only the odemag program and runs from the source tree's
 # python/ too (docs/sweeps.md), where the extension is absent.
+import os as _os
+
+# OpenMP threads that sleep instead of spinning while they wait (docs/python.md
+# "Threads"): libgomp reads OMP_WAIT_POLICY once, when the extension loads it.
+_os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+
 try:
     from ._api import Field, Magnetics, Scene, SceneError, Simulation, Solution, load
 except ImportError as _missing:
     if "_core" not in str(_missing):
         raise
     _MISSING_EXTENSION = str(_missing)
+else:
+    _MISSING_EXTENSION = None
 
-    def __getattr__(name):
+
+def __getattr__(name):
+    # odemag.sweep is imported when first used, so that `python3 -m
+    # odemag.sweeps` (the Dask runner) runs a module not imported before it.
+    if name == "sweep":
+        from .sweeps import sweep
+        return sweep
+    if _MISSING_EXTENSION is not None and name in __all__:
         raise ImportError(f"odemag.{name} needs the built extension odemag._core "
                           f"(build/python, docs/python.md): {_MISSING_EXTENSION}")
+    raise AttributeError(f"module 'odemag' has no attribute '{name}'")
 
-from .sweeps import sweep  # noqa: E402  (odemag.sweep(spec, out, ...): the Dask runner)
 
 __all__ = ["load", "Scene", "Solution", "Field", "Simulation", "Magnetics", "SceneError", "sweep"]

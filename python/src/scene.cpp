@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/simulation/magnetic_system.h"
+#include "odemag/constants.h"
 #include "odemag/solve.h"
 #include "python/src/arrays.h"
 #include "python/src/bindings.h"
@@ -112,6 +113,9 @@ std::vector<Vec3> points_from(const py::object& object) {
     points[static_cast<size_t>(i)] = {r(i, 0), r(i, 1), r(i, 2)};
     if (!is_finite(points[static_cast<size_t>(i)]))
       throw py::value_error("points[" + std::to_string(i) + "]: expected three finite numbers x, y, z (m)");
+    if (norm(points[static_cast<size_t>(i)]) > ranges::kLength.max)
+      throw py::value_error("points[" + std::to_string(i) + "]: farther than the largest accepted length, " +
+                            std::string(py::str(py::float_(ranges::kLength.max))) + " m, from the origin (docs/scene-format.md \"Ranges\")");
   }
   return points;
 }

@@ -50,6 +50,21 @@ Vec3 vec3_from(const py::object& object, const char* what) {
   return {a.at(0), a.at(1), a.at(2)};
 }
 
+// A control of MagneticForces (its checks: docs/embedding.md "Checks"), its
+// std::invalid_argument raised as ValueError naming the Python call:
+// "set_magnetization_scale: the scale 1e+300 of body 0 "magnet" ...".
+template <class F>
+void checked(const char* call, F control) {
+  try {
+    control();
+  } catch (const std::invalid_argument& e) {
+    std::string message = e.what();
+    if (message.rfind("MagneticForces::", 0) == 0)
+      if (const size_t colon = message.find(": "); colon != std::string::npos) message.erase(0, colon + 2);
+    throw py::value_error(std::string(call) + ": " + message);
+  }
+}
+
 py::dict report_dict(const RelaxReport& r) {
   py::dict d;
   d["iterations"] = r.iterations;
@@ -182,14 +197,18 @@ class PySimulation {
   }
 
   void set_magnetization_scale(const py::object& body, double scale) {
-    sim_.magnetics().set_magnetization_scale(index(body), scale);
+    const int b = index(body);
+    checked("set_magnetization_scale", [&] { sim_.magnetics().set_magnetization_scale(b, scale); });
   }
   double magnetization_scale(const py::object& body) const { return sim_.magnetics().magnetization_scale(index(body)); }
   py::array_t<double> external_field() const {
     const Vec3 H = sim_.magnetics().external_field();
     return double_array({H.x, H.y, H.z});
   }
-  void set_external_field(const py::object& H) { sim_.magnetics().set_external_field(vec3_from(H, "external_field")); }
+  void set_external_field(const py::object& H) {
+    const Vec3 field = vec3_from(H, "external_field");
+    checked("external_field", [&] { sim_.magnetics().set_external_field(field); });
+  }
 
   const Simulation& simulation() const { return sim_; }
   std::string backend_name() { return sim_.magnetics().backend().name(); }
@@ -233,6 +252,7 @@ class PyMagnetics {
                             ", 4) or matrices of shape (" + std::to_string(n) + ", 3, 3)");
     const double* pd = p.data();
     const double* rd = r.data();
+    std::vector<BodyPose> poses;
     for (py::ssize_t b = 0; b < n; ++b) {
       BodyPose pose;
       pose.position = {pd[3 * b], pd[3 * b + 1], pd[3 * b + 2]};
@@ -243,7 +263,18 @@ class PyMagnetics {
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j) pose.rotation.m[i][j] = rd[9 * b + 3 * i + j];
       }
-      forces_->set_pose(static_cast<int>(b), pose);
+      poses.push_back(pose);
+    }
+    // A refused pose (not finite, beyond the length bound, a rotation not
+    // orthonormal to 1e-9: docs/embedding.md "Checks") changes nothing.
+    const std::vector<BodyPose> before = forces_->state().pose;
+    try {
+      checked("set_poses", [&] {
+        for (py::ssize_t b = 0; b < n; ++b) forces_->set_pose(static_cast<int>(b), poses[static_cast<size_t>(b)]);
+      });
+    } catch (const py::value_error&) {
+      forces_->state().pose = before;
+      throw;
     }
   }
 
@@ -266,14 +297,18 @@ class PyMagnetics {
   void set_active(const py::object& body, bool active) { forces_->set_active(index(body), active); }
   bool active(const py::object& body) const { return forces_->active(index(body)); }
   void set_magnetization_scale(const py::object& body, double scale) {
-    forces_->set_magnetization_scale(index(body), scale);
+    const int b = index(body);
+    checked("set_magnetization_scale", [&] { forces_->set_magnetization_scale(b, scale); });
   }
   double magnetization_scale(const py::object& body) const { return forces_->magnetization_scale(index(body)); }
   py::array_t<double> external_field() const {
     const Vec3 H = forces_->external_field();
     return double_array({H.x, H.y, H.z});
   }
-  void set_external_field(const py::object& H) { forces_->set_external_field(vec3_from(H, "external_field")); }
+  void set_external_field(const py::object& H) {
+    const Vec3 field = vec3_from(H, "external_field");
+    checked("external_field", [&] { forces_->set_external_field(field); });
+  }
   const SceneDescription& scene() const { return scene_; }
   std::string backend_name() { return forces_->backend().name(); }
 

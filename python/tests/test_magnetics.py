@@ -50,6 +50,29 @@ def test_magnetics_pose_errors():
         m.set_poses([[0, 0, 0.1], [0, 0, np.inf]], [[1, 0, 0, 0]] * 2)
 
 
+def test_magnetics_controls_take_the_scenes_ranges():
+    # Each refused with ValueError naming the argument and the body, changing nothing.
+    m = odemag.Magnetics(odemag.load(SCENE))
+    with pytest.raises(ValueError, match=r'set_poses: .*body 0 "bar".*rotation .* not orthonormal'):
+        m.set_poses([[0, 0, 0], [0, 0, 0.1]], [2 * np.eye(3), np.eye(3)])
+    with pytest.raises(ValueError, match=r'set_poses: .*body 1 "ball".*farther than'):
+        m.set_poses([[0, 0, 0], [0, 0, 2e6]], [[1, 0, 0, 0]] * 2)
+    with pytest.raises(ValueError, match=r'set_magnetization_scale: the scale 1e\+300 of body 0 "bar"'):
+        m.set_magnetization_scale("bar", 1e300)
+    assert m.magnetization_scale("bar") == 1.0
+    with pytest.raises(ValueError, match=r"external_field: .*stronger than the largest accepted"):
+        m.external_field = [1e160, 0, 0]
+    np.testing.assert_array_equal(m.external_field, [0, 0, 0])
+    m.set_poses([[0, 0, 0], [0, 0, 0.1]], [np.eye(3)] * 2)
+    m.compute()
+    assert np.all(np.isfinite(m.forces))
+
+
+def test_field_point_beyond_the_length_bound_names_its_index():
+    with pytest.raises(ValueError, match=r"points\[1\]: farther than the largest accepted length"):
+        odemag.load(SCENE).field([[0, 0, 0.1], [1e300, 0, 0]])
+
+
 def test_result_arrays_are_views_of_their_own_buffers():
     scene = odemag.load(SCENE)
     sol = scene.solve()

@@ -127,6 +127,50 @@ def test_magnetization_scale_control():
     np.testing.assert_array_equal(sim.external_field, [0.0, 0.0, 40.0])
 
 
+CONTROL_CHILD = r"""
+import sys, numpy as np, odemag
+sim = odemag.Simulation(odemag.load(sys.argv[1]))
+for scale in (1e300, 1e6):
+    try:
+        sim.set_magnetization_scale("magnet", scale)
+        print("taken", scale)
+    except ValueError as e:
+        print("refused", scale, e)
+sim.step()
+# The largest accepted scale: the run stays finite or stops at the NaN
+# guard's message, never in ODE.
+sim.set_magnetization_scale("magnet", float(sys.argv[2]))
+try:
+    sim.run(0.05)
+    print("finite", bool(np.all(np.isfinite(sim.positions))), float(np.max(np.abs(sim.positions))))
+except RuntimeError as e:
+    print("guard", e)
+"""
+
+
+def test_magnetization_scale_beyond_the_range_is_refused_and_the_process_exits_cleanly(tmp_path):
+    # 1e300 gave an ODE internal error and an abort at exit (status 134); 1e6
+    # sent a ball 536 km up in 0.05 s.
+    import os
+    import subprocess
+    import sys
+    scene = ROOT / "examples/drop_on_magnet.json"
+    magnet = json.loads(scene.read_text())["materials"]["magnet"]["magnetization"]
+    largest = 1e9 / max(abs(x) for x in magnet)
+    child = tmp_path / "child.py"
+    child.write_text(CONTROL_CHILD)
+    r = subprocess.run([sys.executable, str(child), str(scene), repr(largest)], capture_output=True, text=True,
+                       timeout=300, env=os.environ)
+    assert r.returncode == 0, r.stderr
+    assert "ODE" not in r.stderr, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0].startswith('refused 1e+300 set_magnetization_scale: the scale 1e+300 of body'), r.stdout
+    assert lines[1].startswith("refused 1000000.0"), r.stdout
+    assert lines[2].startswith("finite True") or lines[2].startswith("guard "), r.stdout
+    if lines[2].startswith("guard "):
+        assert "non-finite state" in lines[2]
+
+
 def test_run_arguments():
     sim = odemag.Simulation(odemag.load(ROOT / "examples/compass_needle.json"))
     with pytest.raises(ValueError):

@@ -2,6 +2,8 @@
 // scenes and checks its output, its stderr and its exit status.
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <signal.h>
+#include <sys/wait.h>
 
 #include <algorithm>
 #include <cmath>
@@ -696,8 +698,72 @@ TEST_F(Cli, RerunIntoTheSameOutReplacesThePreviousRunsFiles) {
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"notes.txt", "state.jsonl", "summary.json"}));
+  EXPECT_EQ(names, (std::vector<std::string>{".odemag.lock", "notes.txt", "state.jsonl", "summary.json"}));
   EXPECT_EQ(lines(read_file(out / "state.jsonl")).size(), 2u);
+}
+
+// Two runs into one --out at once: the second is refused (exit 2, one line
+// naming the first's pid) while the first runs, and writes nothing; the lock
+// goes with the first run, also when it is killed with SIGKILL.
+TEST_F(Cli, SecondRunIntoAnOutInUseExitsTwoNamingTheFirst) {
+  const fs::path scene = write("scene.json", two_balls());
+  const fs::path out = dir_ / "out";
+  const std::string first_command = shell_quote(kOdemag) + " run " + shell_quote(scene.string()) + " --out " +
+                                    shell_quote(out.string()) +
+                                    " --duration 1000 --frames no --quiet yes --backend cpu --threads 1";
+  const pid_t first = ::fork();
+  ASSERT_GE(first, 0);
+  if (first == 0) {
+    ::execl("/bin/sh", "sh", "-c", ("exec " + first_command + " >/dev/null 2>&1").c_str(), nullptr);
+    ::_exit(127);
+  }
+  // The first run holds the lock once its lock file names it.
+  for (int i = 0; i < 500 && read_file(out / ".odemag.lock") != std::to_string(first) + "\n"; ++i) ::usleep(20000);
+  ASSERT_EQ(read_file(out / ".odemag.lock"), std::to_string(first) + "\n");
+  const fs::path other = write("other.txt", "");
+  ProgramRun r = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) +
+                        " --duration 0.01 --frames no --quiet yes --backend cpu");
+  EXPECT_EQ(r.status, 2) << r.err;
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("another odemag run (pid " + std::to_string(first) + ")"), std::string::npos) << r.err;
+  ::kill(first, SIGKILL);
+  int raw = 0;
+  ::waitpid(first, &raw, 0);
+  r = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) +
+             " --duration 0.01 --frames no --quiet yes --backend cpu");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out / "summary.json"));
+}
+
+// The temporary files a killed run leaves (a frame or summary.json being
+// written) are removed by the next run into the folder; other files stay.
+TEST_F(Cli, NextRunRemovesAKilledRunsTemporaryFilesOnly) {
+  const fs::path scene = write("scene.json", two_balls());
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out);
+  const std::vector<std::string> leftovers = {"frame_00003.png.tmp-a1B2c3", "summary.json.tmp-4242"};
+  const std::vector<std::string> kept = {"frame_00003.png.tmp-mine", "notes.tmp-123456", "frame.png.tmp-abcdef",
+                                         "summary.json.tmp-x"};
+  for (const std::string& name : leftovers) write("out/" + name, "partial");
+  for (const std::string& name : kept) write("out/" + name, "mine");
+  const ProgramRun r = odemag("run " + shell_quote(scene.string()) + " --out " + shell_quote(out.string()) +
+                              " --duration 0.01 --frames no --quiet yes --backend cpu");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const std::string& name : leftovers) EXPECT_FALSE(fs::exists(out / name)) << name;
+  for (const std::string& name : kept) EXPECT_EQ(read_file(out / name), "mine") << name;
+}
+
+// A field point beyond the length bound (1e6 m) is bad input: exit 2 naming
+// the line, not a relaxation failure (exit 1).
+TEST_F(Cli, FieldPointBeyondTheLengthBoundExitsTwoNamingTheLine) {
+  const fs::path scene = write("scene.json", two_balls());
+  const fs::path points = write("points.csv", "x,y,z\n0,0,0.1\n\n1e300,0,0\n");
+  const ProgramRun r =
+      odemag("field " + shell_quote(scene.string()) + " --points " + shell_quote(points.string()) + " --backend cpu");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.out, "");
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("odemag: " + points.string() + ": line 4: ", 0), 0u) << r.err;
 }
 
 TEST_F(Cli, EventsAtTimeZeroShowInSolveAndInTheFirstStateLine) {

@@ -137,6 +137,31 @@ TEST_F(Sweep, BadSpecsAndFlagsNameTheFileAndTheKeyAndWriteNothing) {
   EXPECT_NE(r.err.find((dir_ / "base.json").string() + ": gravity"), std::string::npos) << r.err;
 }
 
+// --out that is a file, or a missing folder for --gather, is bad input
+// (exit 2, one line naming --out), as for `odemag run`; nothing is written.
+TEST_F(Sweep, OutThatIsAFileOrAMissingGatherFolderExitsTwo) {
+  const fs::path s = spec(R"("grid": {"seed": [1, 2]})");
+  const fs::path file = write("a_file", "keep me");
+  for (const char* mode : {"", "--expand", "--slurm", "--variant 0", "--gather", "--dask local:1"}) {
+    const ProgramRun r =
+        odemag("sweep " + shell_quote(s.string()) + " --out " + shell_quote(file.string()) + " " + std::string(mode));
+    EXPECT_EQ(r.status, 2) << mode << ": " << r.err;
+    ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+    EXPECT_EQ(r.err.rfind("odemag: --out " + file.string() + ": exists and is not a directory", 0), 0u) << r.err;
+    EXPECT_EQ(read_file(file), "keep me");
+  }
+  const ProgramRun r = odemag("sweep " + shell_quote(s.string()) + " --out " + shell_quote((dir_ / "none").string()) +
+                              " --gather");
+  EXPECT_EQ(r.status, 2) << r.err;
+  ASSERT_EQ(lines(r.err).size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("no such directory"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "none"));
+  const ProgramRun below = odemag("sweep " + shell_quote(s.string()) + " --out " +
+                                  shell_quote((file / "out").string()) + " --expand");
+  EXPECT_EQ(below.status, 2) << below.err;
+  EXPECT_NE(below.err.find("is not a directory"), std::string::npos) << below.err;
+}
+
 TEST_F(Sweep, GridExpandsInOrderTheFirstKeySlowest) {
   const ProgramRun r = sweep(spec(R"("grid": {"materials.steel.susceptibility": [10, 100, 1000],
                                               "bodies[5].position[2]": [0.005, 0.006]})"),

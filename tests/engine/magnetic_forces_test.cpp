@@ -294,6 +294,92 @@ TEST(MagneticForcesApi, NonFiniteFieldAndScaleThrow) {
   }
 }
 
+// The controls take the scene loader's ranges (odemag/constants.h): a
+// magnetization scaled beyond 1e9 A/m (the bar's 8e5 A/m: scale 1250), a
+// field beyond 1e9 A/m, a position beyond 1e6 m, a rotation that is not one
+// (2 I, a reflection, off by 1e-8) are refused naming the call and the body,
+// changing nothing; within them they are taken.
+TEST(MagneticForcesApi, ControlsTakeTheScenesRanges) {
+  MagnetAndBall s;
+  for (double scale : {1e300, -1e6, 1251.0}) {
+    try {
+      s.magnetics.set_magnetization_scale(s.magnet, scale);
+      ADD_FAILURE() << "scale " << scale << ": no exception";
+    } catch (const std::invalid_argument& e) {
+      expect_names(e.what(), "set_magnetization_scale", "bar", s.magnet);
+      EXPECT_NE(std::string(e.what()).find("at most 1250"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(s.magnetics.magnetization_scale(s.magnet), 1.0);
+  EXPECT_NO_THROW(s.magnetics.set_magnetization_scale(s.magnet, -1250.0));
+  EXPECT_NO_THROW(s.magnetics.set_magnetization_scale(s.ball, 1e300));  // no magnetization to scale
+
+  EXPECT_THROW(s.magnetics.set_external_field({1e160, 0, 0}), std::invalid_argument);
+  EXPECT_THROW(s.magnetics.set_external_field({6e8, 6e8, 6e8}), std::invalid_argument);  // |H| = 1.04e9
+  EXPECT_EQ(s.magnetics.external_field().x, 0.0);
+  EXPECT_NO_THROW(s.magnetics.set_external_field({1e9, 0, 0}));
+
+  BodyPose far;
+  far.position = {0, 0, 1.1e6};
+  Mat3 twice;
+  for (int i = 0; i < 3; ++i) twice.m[i][i] = 2.0;
+  Mat3 mirror;
+  mirror.m[2][2] = -1.0;
+  Mat3 skewed;
+  skewed.m[0][1] = 1e-8;
+  for (const auto& [pose, what] : {std::pair{far, "position"}, std::pair{BodyPose{twice, {}}, "not orthonormal"},
+                                   std::pair{BodyPose{mirror, {}}, "reflection"},
+                                   std::pair{BodyPose{skewed, {}}, "not orthonormal"}}) {
+    try {
+      s.magnetics.set_pose(s.magnet, pose);
+      ADD_FAILURE() << what << ": no exception";
+    } catch (const std::invalid_argument& e) {
+      expect_names(e.what(), "set_pose", "bar", s.magnet);
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(s.magnetics.state().pose[s.magnet].rotation.m[0][0], 1.0);
+  Mat3 nearly;
+  nearly.m[0][1] = 1e-10;  // within 1e-9: ODE's own rotations drift this much
+  EXPECT_NO_THROW(s.magnetics.set_pose(s.magnet, BodyPose{nearly, {0, 0, 1e6}}));
+}
+
+// field_at_points refuses a point beyond the length bound, naming its index
+// (a point 1e300 m away gave NaN).
+TEST(MagneticForcesApi, FieldPointBeyondTheLengthBoundThrowsNamingIt) {
+  MagnetAndBall s;
+  s.magnetics.compute();
+  std::vector<Vec3> B, H;
+  try {
+    s.magnetics.field_at_points({{0, 0, 0.1}, {1e300, 0, 0}}, B, H);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("point 1 "), std::string::npos) << e.what();
+  }
+  s.magnetics.field_at_points({{0, 0, 0.1}, {1e6, 0, 0}}, B, H);
+  EXPECT_TRUE(is_finite(H[1]));
+}
+
+// attach names the call and the body (the index and name it would get) when
+// it refuses a shape or a material.
+TEST(MagneticForcesApi, AttachRefusalNamesTheCallAndTheBody) {
+  MagneticForces magnetics({}, make_cpu_backend(1));
+  magnetics.attach(nullptr, Sphere{0.01}, test_support::soft_material(1e6, 100), 0.0, "first");
+  try {
+    magnetics.attach(nullptr, Sphere{-1}, test_support::soft_material(1e6, 100));
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    expect_names(e.what(), "MagneticForces::attach", "body1", 1);
+  }
+  try {
+    magnetics.attach(nullptr, Sphere{0.01}, PermanentMaterial{{std::nan(""), 0, 0}, 0.0}, 0.0, "bar");
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    expect_names(e.what(), "MagneticForces::attach", "bar", 1);
+  }
+  EXPECT_EQ(magnetics.body_count(), 1);
+}
+
 // An ODE world with auto-disable on: a ground plane and an iron ball resting
 // on it, stepped with contacts.
 struct SleepyWorld {

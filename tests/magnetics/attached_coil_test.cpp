@@ -116,6 +116,39 @@ TEST(AttachedCoil, CoilMagnetizesASoftBallAndScalesWithItsBody) {
   }
 }
 
+// An iron ball passing through the wire of a 1000 ampere-turn loop (wire
+// radius a = 0.5 mm, the default 1% of R = 5 cm): its force and torque stay
+// bounded, |F| <= mu0 |mu| 3.3 N I / (2 pi a^2) (the bound of |grad H|,
+// magnetics/coil_test.cpp FilamentWire) and |tau| <= mu0 |mu| N I / (2 pi a) +
+// |r x F| over the positions across the wire, 1 um from the centre line
+// included (with a wire of no thickness: 1.4e7 N there).
+TEST(AttachedCoil, ForceOnABallPassingThroughTheWireStaysBounded) {
+  const double R = 0.05, NI = 1000.0, a = 0.01 * R;
+  const SoftMaterial iron = test_support::soft_material(1.7e6, 1000.0);
+  double largest_F = 0.0, bound_F = 0.0;
+  for (double d : {-2e-3, -6e-4, -4e-4, -2e-4, -1e-6, 0.0, 1e-6, 1e-5, 1e-4, 3e-4, 5e-4, 1e-3}) {
+    CoilAndBall s;
+    s.model.add_body("frame", Box{{0.01, 0.01, 0.01}}, InertMaterial{}, 0.0);
+    CircularLoop l;
+    l.radius = R;
+    l.current = 100.0;
+    l.turns = 10.0;
+    s.model.add_coil(0, l);
+    s.model.add_body("ball", Sphere{0.003}, iron, 0.0);
+    s.state = make_state(s.model);
+    s.state.pose[1].position = {R + 0.3 * d, 0.0, d};
+    ASSERT_TRUE(magnetic_step(s.model, s.state, tight(), *s.backend).converged) << d;
+    const double mu = norm(s.state.magnetization[0]) * ball_volume();
+    const double F_bound = kMu0 * mu * 3.3 * NI / (2.0 * kPi * a * a);
+    EXPECT_TRUE(is_finite(s.state.force[1]));
+    EXPECT_LE(norm(s.state.force[1]), F_bound + 1e-12) << "d = " << d;
+    EXPECT_LE(norm(s.state.torque[1]), kMu0 * mu * 1.1 * NI / (2.0 * kPi * a) + 1e-12) << "d = " << d;
+    largest_F = std::max(largest_F, norm(s.state.force[1]));
+    bound_F = std::max(bound_F, F_bound);
+  }
+  std::printf("measured: ball through a loop's wire, largest |F| %.3g N (bound %.3g N)\n", largest_F, bound_F);
+}
+
 // The coil moves with its body: a loop turned by 90 degrees about x (axis
 // now -y) and shifted gives a ball on its new axis the same force, turned.
 TEST(AttachedCoil, CoilMovesWithItsBody) {
