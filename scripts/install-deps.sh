@@ -14,7 +14,7 @@ fi
 
 packages=(
   build-essential cmake pkg-config
-  libode-dev libeigen3-dev libosmesa6-dev libpng-dev nlohmann-json3-dev
+  libode-dev libeigen3-dev libosmesa6-dev libpng-dev nlohmann-json3-dev libassimp-dev
   libfreetype-dev fonts-dejavu-core
   libgtest-dev libbenchmark-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-pyode  # the Python package and its tests (docs/python.md)
