@@ -772,11 +772,11 @@ struct MeshSpec {
 };
 
 const KeyTable<MeshSpec> kMeshKeys = {
-    {.name = "file", .check = Check::non_empty_string, .slot = SLOT(file), .doc = {"string", "", ""}},
+    {.name = "file", .check = Check::non_empty_string, .slot = SLOT(file), .doc = {"string", "", "none"}},
     {.name = "scale", .read = [](const SceneReader& r, const json& x, const std::string& p, MeshSpec& m) {
        m.scale = r.bounded(r.positive(x, p), p, kLength);
      },
-     .doc = {"number", "m per file unit", "1"}},
+     .doc = {"number", "m per unit", "`1`"}},
     {.name = "vertices",
      .read = [](const SceneReader& r, const json& x, const std::string& p, MeshSpec& m) {
        if (!x.is_array() || x.empty()) r.fail(p, "must be a non-empty array of [x, y, z]");
@@ -784,7 +784,7 @@ const KeyTable<MeshSpec> kMeshKeys = {
        for (size_t i = 0; i < x.size(); ++i) m.vertices.push_back(r.bounded(r.vec3(x[i], element(p, i)), element(p, i), kLength));
        m.inline_vertices = true;
      },
-     .doc = {"array of [x, y, z]", "m (times scale)", ""}},
+     .doc = {"[[x, y, z], ...]", "units", "none"}},
     {.name = "triangles",
      .read = [](const SceneReader& r, const json& x, const std::string& p, MeshSpec& m) {
        if (!x.is_array() || x.empty()) r.fail(p, "must be a non-empty array of [i, j, k]");
@@ -798,7 +798,7 @@ const KeyTable<MeshSpec> kMeshKeys = {
        }
        m.inline_triangles = true;
      },
-     .doc = {"array of [i, j, k]", "", ""}},
+     .doc = {"[[i, j, k], ...]", "", "none"}},
 };
 
 // A mesh from a file or inline: checked, turned outward (with a notice),
@@ -857,15 +857,15 @@ const KeyTable<PartTarget> kCompoundPartKeys = {
      },
      .required = true, .doc = {"object", "m", "**required**"}},
     {.name = "position", .check = Check::vec3, .slot = SLOT(part.position), .bound = kLength,
-     .doc = {"[x, y, z]", "m", "[0, 0, 0]"}},
+     .doc = {"vector", "m", "`[0, 0, 0]`"}},
     {.name = "orientation", .check = Check::quaternion, .slot = SLOT(orientation),
-     .doc = {"[w, x, y, z]", "", "[1, 0, 0, 0]"}},
+     .doc = {"[w, x, y, z]", "", "`[1, 0, 0, 0]`"}},
     {.name = "material",
      .read = [](const SceneReader& r, const json&, const std::string& p, PartTarget&) {
        r.fail(p, "a compound's parts share their body's material: parts of different materials in one body "
                  "are not supported (docs/scene-format.md \"Compounds\")");
      },
-     .doc = {"refused", "", ""}},
+     .doc = {"string", "", "none"}},
 };
 
 Compound read_compound(const SceneReader& r, const json& v, const std::string& path) {
