@@ -7,6 +7,7 @@
 #include "magnetics/relax/relax.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -133,6 +134,23 @@ void MagneticForces::refine_body(int index, const std::vector<RefinedZone>& zone
 
 int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& material,
                            double cell_size, const std::string& name) {
+  // A mesh or compound is given in the body frame, whose origin ODE puts at
+  // the centre of mass (docs/embedding.md "Meshes").
+  if (std::holds_alternative<Mesh>(shape) || std::holds_alternative<Compound>(shape)) {
+    if (std::string e = validate_shape(shape); !e.empty()) throw std::invalid_argument("MagneticForces::attach: " + e);
+    const double size = norm(shape_half_extents(shape));
+    Vec3 c;
+    if (const Mesh* m = std::get_if<Mesh>(&shape)) mesh_centred(*m, &c);
+    else compound_centred(std::get<Compound>(shape), &c);
+    if (norm(c) > 1e-6 * size) {
+      char text[160];
+      std::snprintf(text, sizeof text, "(%.6g, %.6g, %.6g) m", c.x, c.y, c.z);
+      throw std::invalid_argument(std::string("MagneticForces::attach: the ") + shape_kind(shape) +
+                                  "'s centre of mass is at " + text +
+                                  ", not at the body's origin: pass mesh_centred(mesh) (compound_centred) and put "
+                                  "the ODE body at the centre of mass");
+    }
+  }
   const int index = model_->add_body(name.empty() ? "body" + std::to_string(model_->body_count()) : name,
                                     shape, material, cell_size);
   extend_state(*model_, *state_);
