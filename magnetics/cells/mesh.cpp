@@ -289,7 +289,9 @@ const MeshData::Index& mesh_index(const Mesh& mesh) {
   return *d.index;
 }
 
-std::string validate_mesh(const Mesh& mesh) {
+namespace {
+
+std::string check_mesh(const Mesh& mesh) {
   const auto& V = mesh.vertices();
   const auto& T = mesh.triangles();
   const long nv = static_cast<long>(V.size());
@@ -382,6 +384,14 @@ std::string validate_mesh(const Mesh& mesh) {
     return "the mesh intersects itself: triangles " + std::to_string(crossing) + " and " +
            std::to_string(crossing_other) + " cross";
   return "";
+}
+
+}  // namespace
+
+std::string validate_mesh(const Mesh& mesh) {
+  const MeshData& d = mesh.data();
+  std::call_once(d.check_once, [&] { d.check = check_mesh(mesh); });
+  return d.check;
 }
 
 Mesh mesh_outward(const Mesh& mesh, bool* flipped) {

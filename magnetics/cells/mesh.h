@@ -66,6 +66,9 @@ struct MeshData {
   struct Index;
   mutable std::shared_ptr<Index> index;
   mutable std::once_flag index_once;
+  // validate_mesh's answer, found once (the loader and the model both ask).
+  mutable std::string check;
+  mutable std::once_flag check_once;
 };
 
 struct MeshData::Index {
@@ -85,9 +88,9 @@ const MeshData::Index& mesh_index(const Mesh& mesh);
 // repeating a vertex, closed (every edge shared by exactly two triangles),
 // consistently oriented (the two triangles of an edge traverse it in
 // opposite directions), non-zero volume, no two triangles crossing. Empty
-// when valid, else one message. The sign of the volume is not checked: an
-// inverted mesh (every triangle clockwise) is valid here and turned by
-// mesh_outward.
+// when valid, else one message (found once per mesh). The sign of the
+// volume is not checked: an inverted mesh (every triangle clockwise) is
+// valid here and turned by mesh_outward.
 std::string validate_mesh(const Mesh& mesh);
 
 // Closed mesh whose triangles are all clockwise seen from outside (negative
