@@ -92,6 +92,8 @@ TEST(MeshContact, CompoundRestsOnItsParts) {
   s.bodies.push_back(body("plate", test::box_surface_mesh({0.06, 0.06, 0.004}, 4), "wood", {0, 0, 0}, true));
   s.bodies.push_back(body("pair", Compound(parts), "wood", {0, 0, 0.02}, false, 700.0));
   Simulation sim(s);
+  // Mass from the union's volume and the density.
+  EXPECT_NEAR(sim.world().mass(1), 700.0 * 2 * 0.01 * 0.01 * 0.004, 1e-12);
   for (int k = 0; k < 1000; ++k) sim.step();
   const BodyPose p = sim.world().pose(1);
   EXPECT_NEAR(p.position.z - kPlateTop, 0.002, 1e-4);
