@@ -30,7 +30,7 @@ SoftMaterial linear_soft(double chi) {
 }
 
 // The moment of a soft body in the uniform field H0 (relaxed to 1e-6: a mesh
-// body's residual stalls near 1e-9, docs/model.md "Meshes").
+// body's residual stalls between 1e-7 and 1e-8, docs/model.md "Meshes").
 Vec3 soft_moment(const Shape& shape, double chi, double h, const Vec3& H0, int* cells = nullptr) {
   MagneticModel model;
   model.add_body("body", shape, linear_soft(chi), h);
