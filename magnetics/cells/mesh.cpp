@@ -353,11 +353,12 @@ std::string check_mesh(const Mesh& mesh) {
     const double e0 = orient(p, q, t.a, t.b), e1 = orient(p, q, t.b, t.c), e2 = orient(p, q, t.c, t.a);
     return (e0 > 0.0 && e1 > 0.0 && e2 > 0.0) || (e0 < 0.0 && e1 < 0.0 && e2 < 0.0);
   };
+  // Every bin is searched, so that the pair reported (the lowest first
+  // index, then the lowest second) does not depend on the threads.
   const long bins = static_cast<long>(g.start.size()) - 1;
   long crossing = -1, crossing_other = -1;
 #pragma omp parallel for schedule(dynamic, 64)
   for (long bin = 0; bin < bins; ++bin) {
-    if (crossing >= 0) continue;
     const int i = static_cast<int>(bin % g.dims[0]), j = static_cast<int>((bin / g.dims[0]) % g.dims[1]),
               k = static_cast<int>(bin / (static_cast<long>(g.dims[0]) * g.dims[1]));
     for (int s = g.start[bin]; s < g.start[bin + 1]; ++s)
@@ -375,8 +376,10 @@ std::string check_mesh(const Mesh& mesh) {
                            segment_crosses(A.c, A.a, B) || segment_crosses(B.a, B.b, A) ||
                            segment_crosses(B.b, B.c, A) || segment_crosses(B.c, B.a, A);
         if (cross) {
+          const long first = std::min(ta, tb), second = std::max(ta, tb);
 #pragma omp critical(odemag_mesh_crossing)
-          if (crossing < 0 || std::min(ta, tb) < crossing) crossing = std::min(ta, tb), crossing_other = std::max(ta, tb);
+          if (crossing < 0 || first < crossing || (first == crossing && second < crossing_other))
+            crossing = first, crossing_other = second;
         }
       }
   }
