@@ -357,6 +357,7 @@ int run_simulation(const std::vector<std::string>& args, const FrameWriterFactor
   const SolveOptions& options = c.solve;
 
   SceneDescription scene = load_scene(c.scene);
+  for (const std::string& n : scene.notices) std::fprintf(stderr, "odemag run: %s\n", n.c_str());
   SimulationSettings& settings = scene.simulation;
   settings.duration = c.duration.value_or(settings.duration);
   settings.frame_rate = c.frame_rate.value_or(settings.frame_rate);

@@ -157,6 +157,7 @@ int run_solve(const std::vector<std::string>& args) {
   const SolveCommandLine c = parse_solve_command(args);
   const SolveOptions& options = c.solve;
   const SceneDescription scene = load_scene(c.scene);
+  for (const std::string& n : scene.notices) std::fprintf(stderr, "odemag solve: %s\n", n.c_str());
   check_cell_pairs(scene, options);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);
   for (const std::string& notice : scene_notices(scene)) std::fprintf(stderr, "odemag solve: %s\n", notice.c_str());
@@ -194,6 +195,7 @@ int run_field(const std::vector<std::string>& args) {
   const SolveOptions& options = c.solve;
 
   const SceneDescription scene = load_scene(c.scene);
+  for (const std::string& n : scene.notices) std::fprintf(stderr, "odemag field: %s\n", n.c_str());
   check_cell_pairs(scene, options);
   const std::vector<Vec3> points = read_points(c.points);
   const std::unique_ptr<MagneticBackend> backend = scene_backend(scene, options);

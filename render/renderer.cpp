@@ -51,6 +51,18 @@ RenderPrimitive RenderPrimitive::cylinder(const Vec3& centre, double radius, dou
   return p;
 }
 
+RenderPrimitive RenderPrimitive::of_surface(const Vec3& centre, std::shared_ptr<const RenderSurface> surface,
+                                            const Mat3& rotation, const RenderColor& color) {
+  RenderPrimitive p;
+  p.kind = Kind::surface;
+  p.size = {1.0, 1.0, 1.0};
+  p.surface = std::move(surface);
+  p.rotation = rotation;
+  p.position = centre;
+  p.color = color;
+  return p;
+}
+
 namespace {
 
 // ---------------------------------------------------------------- matrices
@@ -258,6 +270,7 @@ double bounding_radius(const RenderPrimitive& p) {
     case RenderPrimitive::Kind::sphere: return std::max({s.x, s.y, s.z});
     case RenderPrimitive::Kind::box: return 0.5 * norm(s);
     case RenderPrimitive::Kind::cylinder: return std::hypot(std::max(s.x, s.y), 0.5 * s.z);
+    case RenderPrimitive::Kind::surface: return p.surface ? p.surface->radius : 0.0;
   }
   return norm(s);
 }
@@ -325,8 +338,25 @@ struct OffscreenRenderer::Impl {
       case RenderPrimitive::Kind::sphere: return sphere_lists[level];
       case RenderPrimitive::Kind::box: return cube_list;
       case RenderPrimitive::Kind::cylinder: return cylinder_lists[level];
+      case RenderPrimitive::Kind::surface: return 0;
     }
     return cube_list;
+  }
+
+  // The primitive's triangles: its display list, or its surface from client
+  // memory.
+  void draw_shape(const RenderPrimitive& p, double pixel_radius) const {
+    if (p.kind != RenderPrimitive::Kind::surface) {
+      glCallList(list_for(p.kind, pixel_radius));
+      return;
+    }
+    if (!p.surface || p.surface->positions.empty()) return;
+    glEnableClientState(GL_VERTEX_ARRAY);
+    glEnableClientState(GL_NORMAL_ARRAY);
+    glVertexPointer(3, GL_FLOAT, 0, p.surface->positions.data());
+    glNormalPointer(GL_FLOAT, 0, p.surface->normals.data());
+    glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(p.surface->positions.size() / 3));
+    glDisableClientState(GL_NORMAL_ARRAY);
   }
 
   void draw_ground(const RenderFrame& scene);
@@ -442,7 +472,7 @@ void OffscreenRenderer::Impl::draw_shadows(const RenderFrame& scene, const ViewI
     glMultMatrixd(shadow.data());
     glMultMatrixd(rigid_transform(p.rotation, p.position).data());
     glScaled(p.size.x, p.size.y, p.size.z);
-    glCallList(list_for(p.kind, 0.5 * view.pixel_radius(p)));  // shadows can be coarser
+    draw_shape(p, 0.5 * view.pixel_radius(p));  // shadows can be coarser
   }
   glDisable(GL_BLEND);
   glDepthMask(GL_TRUE);
@@ -458,12 +488,12 @@ void OffscreenRenderer::Impl::draw_primitive(const RenderPrimitive& p, const Vie
   glMultMatrixd(rigid_transform(p.rotation, p.position).data());
   const double handedness = determinant(p.rotation) * sx * sy * sz;
   glFrontFace(handedness < 0.0 ? GL_CW : GL_CCW);
-  const GLuint mesh = list_for(p.kind, view.pixel_radius(p));
+  const double pixels = view.pixel_radius(p);
   const Vec3 axis = normalized(p.pole_axis);
   if (squared_norm(axis) == 0.0 || !is_finite(axis)) {
     glScaled(sx, sy, sz);
     set_color(p.color, alpha);
-    glCallList(mesh);
+    draw_shape(p, pixels);
     return;
   }
   // A magnet: two halves cut by the body plane through the centre normal to
@@ -476,12 +506,12 @@ void OffscreenRenderer::Impl::draw_primitive(const RenderPrimitive& p, const Vie
   glPushMatrix();
   glScaled(sx, sy, sz);
   set_color(p.north_color, alpha);
-  glCallList(mesh);
+  draw_shape(p, pixels);
   glPopMatrix();
   glClipPlane(GL_CLIP_PLANE0, south);
   glScaled(sx, sy, sz);
   set_color(p.south_color, alpha);
-  glCallList(mesh);
+  draw_shape(p, pixels);
   glDisable(GL_CLIP_PLANE0);
 }
 

@@ -28,12 +28,22 @@ struct RenderCamera {
   int width = 640, height = 480;
 };
 
+// A triangle surface in its body's frame (m): three vertices per triangle,
+// each with its normal.
+struct RenderSurface {
+  std::vector<float> positions;  // xyz
+  std::vector<float> normals;    // xyz
+  double radius = 0.0;           // of the sphere about the origin holding it
+};
+
 struct RenderPrimitive {
-  enum class Kind { sphere, box, cylinder };
+  enum class Kind { sphere, box, cylinder, surface };
   Kind kind = Kind::sphere;
   // sphere: (R, R, R) (unequal values give an ellipsoid); box: full edge
-  // lengths (lx, ly, lz); cylinder: (R, R, length) with its axis along body z.
+  // lengths (lx, ly, lz); cylinder: (R, R, length) with its axis along body
+  // z; surface: (1, 1, 1), the surface in `surface`.
   Vec3 size{0.01, 0.01, 0.01};
+  std::shared_ptr<const RenderSurface> surface;
   Mat3 rotation;  // body -> world
   Vec3 position;  // world position of the centre
   RenderColor color{0.62f, 0.63f, 0.66f};
@@ -55,6 +65,8 @@ struct RenderPrimitive {
                              const RenderColor& color);
   static RenderPrimitive cylinder(const Vec3& centre, double radius, double length,
                                   const Mat3& rotation, const RenderColor& color);
+  static RenderPrimitive of_surface(const Vec3& centre, std::shared_ptr<const RenderSurface> surface,
+                                    const Mat3& rotation, const RenderColor& color);
 };
 
 // A polyline (GL line strip), drawn after the solids with depth testing, so

@@ -5,9 +5,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <mutex>
 #include <stdexcept>
+#include <utility>
 #include <variant>
 
+#include "magnetics/cells/compound.h"
+#include "magnetics/cells/mesh.h"
 #include "render/png_writer.h"
 #include "magnetics/relax/relax.h"
 #include "odemag/shape.h"
@@ -21,12 +25,82 @@ RenderColor to_color(const std::array<double, 3>& c) {
   return {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])};
 }
 
+// The triangles of a mesh or a compound (every part as triangles, a ball as
+// a subdivided icosahedron, a cylinder as a prism of 64 sides) in the body
+// frame, each corner with the mean normal of the triangles at its vertex
+// within 35 degrees of its own (sharp edges stay sharp).
+std::shared_ptr<const RenderSurface> surface_of(const Shape& shape) {
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  auto add = [&](const Mesh& m, const Vec3& position, const Mat3& orientation) {
+    const int first = static_cast<int>(v.size());
+    for (const Vec3& x : m.vertices()) v.push_back(position + orientation * x);
+    for (const auto& f : m.triangles()) t.push_back({f[0] + first, f[1] + first, f[2] + first});
+  };
+  auto part_mesh = [](const PartShape& p) {
+    return std::visit(Overloaded{[](const Sphere& s) { return ball_mesh(s.radius, 3); },
+                                 [](const Box& b) { return box_mesh(b.size); },
+                                 [](const Cylinder& c) { return cylinder_prism_mesh(c.radius, c.length, 64); },
+                                 [](const Mesh& m) { return m; }},
+                      p);
+  };
+  if (const Mesh* m = std::get_if<Mesh>(&shape)) add(*m, {}, Mat3{});
+  if (const Compound* c = std::get_if<Compound>(&shape))
+    for (const CompoundPart& p : c->parts()) add(part_mesh(p.shape), p.position, p.orientation);
+  std::vector<Vec3> face(t.size());
+  std::vector<std::vector<int>> at(v.size());
+  for (size_t f = 0; f < t.size(); ++f) {
+    face[f] = cross(v[t[f][1]] - v[t[f][0]], v[t[f][2]] - v[t[f][0]]);  // area-weighted
+    for (int k = 0; k < 3; ++k) at[t[f][k]].push_back(static_cast<int>(f));
+  }
+  auto surface = std::make_shared<RenderSurface>();
+  const double crease = std::cos(35.0 * kPi / 180.0);
+  for (size_t f = 0; f < t.size(); ++f) {
+    const Vec3 own = normalized(face[f]);
+    for (int k = 0; k < 3; ++k) {
+      Vec3 n;
+      for (int g : at[t[f][k]])
+        if (dot(normalized(face[g]), own) >= crease) n = n + face[g];
+      n = is_finite(normalized(n)) ? normalized(n) : own;
+      const Vec3& x = v[t[f][k]];
+      surface->positions.insert(surface->positions.end(),
+                                {static_cast<float>(x.x), static_cast<float>(x.y), static_cast<float>(x.z)});
+      surface->normals.insert(surface->normals.end(),
+                              {static_cast<float>(n.x), static_cast<float>(n.y), static_cast<float>(n.z)});
+      surface->radius = std::max(surface->radius, norm(x));
+    }
+  }
+  return surface;
+}
+
+// Surfaces are built once per mesh or compound: the cache holds the shape
+// (so its data, whose address is the key, stays alive).
+std::shared_ptr<const RenderSurface> cached_surface(const Shape& shape) {
+  static std::mutex mutex;
+  static std::vector<std::pair<Shape, std::shared_ptr<const RenderSurface>>> cache;
+  auto key = [](const Shape& s) -> const void* {
+    if (const Mesh* m = std::get_if<Mesh>(&s)) return &m->data();
+    if (const Compound* c = std::get_if<Compound>(&s)) return &c->data();
+    return nullptr;
+  };
+  std::lock_guard<std::mutex> lock(mutex);
+  for (const auto& [s, surface] : cache)
+    if (key(s) == key(shape)) return surface;
+  if (cache.size() >= 64) cache.clear();
+  cache.emplace_back(shape, surface_of(shape));
+  return cache.back().second;
+}
+
 RenderPrimitive primitive_of(const Shape& shape, const BodyPose& pose) {
   return std::visit(
       Overloaded{[&](const Sphere& s) { return RenderPrimitive::sphere(pose.position, s.radius, palette::iron); },
                  [&](const Box& b) { return RenderPrimitive::box(pose.position, b.size, pose.rotation, palette::iron); },
                  [&](const Cylinder& c) {
                    return RenderPrimitive::cylinder(pose.position, c.radius, c.length, pose.rotation, palette::iron);
+                 },
+                 [&](const auto&) {
+                   return RenderPrimitive::of_surface(pose.position, cached_surface(shape), pose.rotation,
+                                                      palette::iron);
                  }},
       shape);
 }

@@ -22,7 +22,7 @@ fi
 
 packages=(
   build-essential cmake pkg-config
-  libode-dev libeigen3-dev libosmesa6-dev libpng-dev nlohmann-json3-dev
+  libode-dev libeigen3-dev libosmesa6-dev libpng-dev nlohmann-json3-dev libassimp-dev
   libfreetype-dev fonts-dejavu-core
   gnuplot-nox
 )

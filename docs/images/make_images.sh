@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Renders the representative frames of each paper scene shown in README.md and
+# Renders the representative frames of each paper scene (and of
+# examples/horseshoe_lift.json) shown in README.md and
 # docs/scenes.md: docs/images/<scene>.png, three or four frames side by side
 # (400 x 300 each, with the renderer's caption band and legend: docs/rendering.md).
 # Needs a build with the renderer (bash scripts/build.sh; the odemag and
@@ -29,16 +30,18 @@ declare -A times=(
   [nail_and_balls]="0.8 2.4 5.0"
   [nail_no_anisotropy]="0.8 2.4 5.0"
   [crane]="1.2 2.9 3.9 5.0"
+  [horseshoe_lift]="0.3 1.4 2.8"
 )
 # scenes drawn with field lines although the scene file has them off: how many
 declare -A field_lines=([crane]=24)
 scenes=("$@")
 [ ${#scenes[@]} -gt 0 ] || scenes=(ball_chain ball_chain_no_induction wood_plate iron_plate thin_iron_plate
-                                   thick_iron_plate nail_and_balls nail_no_anisotropy crane)
+                                   thick_iron_plate nail_and_balls nail_no_anisotropy crane horseshoe_lift)
 rate=10
 for s in "${scenes[@]}"; do
   echo "== $s"
   scene=demos/scenes/$s.json
+  [ -f "$scene" ] || scene=examples/$s.json  # the examples (horseshoe_lift: a mesh)
   if [ -n "${field_lines[$s]:-}" ]; then
     python3 - "$scene" "$work/$s.json" "${field_lines[$s]}" <<'EOF'
 import json, sys

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -169,12 +170,28 @@ int MagneticForces::attach(dBodyID body, const Shape& shape, const Material& mat
                            double cell_size, const std::string& name) {
   const int next = model_->body_count();
   const std::string body_name = name.empty() ? "body" + std::to_string(next) : name;
+  const std::string where = "MagneticForces::attach: body " + std::to_string(next) + " \"" + body_name + "\": ";
+  // A mesh or compound is given in the body frame, whose origin ODE puts at
+  // the centre of mass (docs/embedding.md "Meshes").
+  if (std::holds_alternative<Mesh>(shape) || std::holds_alternative<Compound>(shape)) {
+    if (std::string e = validate_shape(shape); !e.empty()) throw std::invalid_argument(where + e);
+    const double size = norm(shape_half_extents(shape));
+    Vec3 c;
+    if (const Mesh* m = std::get_if<Mesh>(&shape)) mesh_centred(*m, &c);
+    else compound_centred(std::get<Compound>(shape), &c);
+    if (norm(c) > 1e-6 * size) {
+      char text[160];
+      std::snprintf(text, sizeof text, "(%.6g, %.6g, %.6g) m", c.x, c.y, c.z);
+      throw std::invalid_argument(where + "the " + shape_kind(shape) + "'s centre of mass is at " + text +
+                                  ", not at the body's origin: pass mesh_centred(mesh) (compound_centred) and put "
+                                  "the ODE body at the centre of mass");
+    }
+  }
   int index = -1;
   try {
     index = model_->add_body(body_name, shape, material, cell_size);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument("MagneticForces::attach: body " + std::to_string(next) + " \"" + body_name +
-                                "\": " + e.what());
+    throw std::invalid_argument(where + e.what());
   }
   extend_state(*model_, *state_);
   bodies_.push_back(body);

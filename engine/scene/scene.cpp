@@ -24,6 +24,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "engine/scene/mesh_file.h"
+#include "magnetics/cells/compound.h"
+#include "magnetics/cells/mesh.h"
 #include "magnetics/materials/bh_curve.h"
 #include "magnetics/model/model.h"
 #include "odemag/constants.h"
@@ -333,8 +336,12 @@ class SceneReader {
   }
 
   const std::string& file() const { return file_; }
+  // A line for SceneDescription::notices: "KEY: message".
+  void notice(const std::string& path, const std::string& message) const { notices_.push_back(path + ": " + message); }
+  const std::vector<std::string>& notices() const { return notices_; }
 
  private:
+  mutable std::vector<std::string> notices_;
   static std::string describe(const json& v) {
     if (v.is_array()) return "an array of " + std::to_string(v.size());
     if (v.is_object()) return "an object";
@@ -747,6 +754,127 @@ const KeyTable<Cylinder> kCylinderKeys = {
      .required = true},
 };
 
+// ---- meshes and compounds (docs/scene-format.md "Meshes", "Compounds") ----------
+
+struct MeshSpec {
+  std::string file;
+  double scale = 1.0;
+  std::vector<Vec3> vertices;
+  std::vector<std::array<int, 3>> triangles;
+  bool inline_vertices = false, inline_triangles = false;
+};
+
+const KeyTable<MeshSpec> kMeshKeys = {
+    {.name = "file", .check = Check::non_empty_string, .slot = SLOT(file), .doc = {"string", "", "none"}},
+    {.name = "scale", .read = [](const SceneReader& r, const json& x, const std::string& p, MeshSpec& m) {
+       m.scale = r.bounded(r.positive(x, p), p, kLength);
+     },
+     .doc = {"number", "m per unit", "`1`"}},
+    {.name = "vertices",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, MeshSpec& m) {
+       if (!x.is_array() || x.empty()) r.fail(p, "must be a non-empty array of [x, y, z]");
+       if (x.size() > 3 * kMaxMeshTriangles) r.fail(p, std::to_string(x.size()) + " vertices: too many");
+       for (size_t i = 0; i < x.size(); ++i) m.vertices.push_back(r.bounded(r.vec3(x[i], element(p, i)), element(p, i), kLength));
+       m.inline_vertices = true;
+     },
+     .doc = {"[[x, y, z], ...]", "units", "none"}},
+    {.name = "triangles",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, MeshSpec& m) {
+       if (!x.is_array() || x.empty()) r.fail(p, "must be a non-empty array of [i, j, k]");
+       if (x.size() > kMaxMeshTriangles) r.fail(p, "has " + mesh_size_refusal(x.size()));
+       for (size_t i = 0; i < x.size(); ++i) {
+         const std::string q = element(p, i);
+         if (!x[i].is_array() || x[i].size() != 3) r.fail(q, "must be an array of 3 vertex indices");
+         m.triangles.push_back({r.int_value(x[i][0], element(q, 0), 0, std::numeric_limits<int>::max()),
+                                r.int_value(x[i][1], element(q, 1), 0, std::numeric_limits<int>::max()),
+                                r.int_value(x[i][2], element(q, 2), 0, std::numeric_limits<int>::max())});
+       }
+       m.inline_triangles = true;
+     },
+     .doc = {"[[i, j, k], ...]", "", "none"}},
+};
+
+// A mesh from a file or inline: checked, turned outward (with a notice),
+// scaled and moved so that its centre of mass is the body's origin.
+Mesh read_mesh(const SceneReader& r, const json& v, const std::string& path) {
+  MeshSpec spec;
+  read_object(r, v, path, kMeshKeys, spec);
+  const bool from_file = !spec.file.empty();
+  if (from_file == (spec.inline_vertices || spec.inline_triangles))
+    r.fail(path, "must have either file or vertices and triangles");
+  if (!from_file && !(spec.inline_vertices && spec.inline_triangles))
+    r.fail(member(path, spec.inline_vertices ? "triangles" : "vertices"), "required key is missing");
+  // Where a mesh's defect is reported: the file, or the inline arrays.
+  const std::string key = member(path, from_file ? "file" : "triangles");
+  if (from_file) {
+    namespace fs = std::filesystem;
+    fs::path file = spec.file;
+    if (file.is_relative()) file = fs::path(r.file()).parent_path() / file;
+    try {
+      MeshFileContent content = read_mesh_file(file.lexically_normal().string());
+      spec.vertices = std::move(content.vertices);
+      spec.triangles = std::move(content.triangles);
+    } catch (const MeshFileError& e) {
+      r.fail(key, e.what());
+    }
+  }
+  for (Vec3& x : spec.vertices) x = spec.scale * x;
+  const std::string where = from_file ? "mesh file \"" + spec.file + "\": " : "";
+  Mesh mesh(std::move(spec.vertices), std::move(spec.triangles));
+  if (const std::string e = validate_mesh(mesh); !e.empty()) r.fail(key, where + e);
+  bool flipped = false;
+  mesh = mesh_outward(mesh, &flipped);
+  if (flipped) r.notice(key, where + "the triangles run clockwise seen from outside (negative volume); turned outward");
+  const MeshData::Index& ix = mesh_index(mesh);
+  const Vec3 ext = ix.hi - ix.lo;
+  const double big = std::max({ext.x, ext.y, ext.z});
+  if (big > 100.0 || big < 1e-6)
+    r.notice(key, where + "the mesh is " + short_number(big) + " m across: are its units right (" +
+                      member(path, "scale") + ")?");
+  return mesh_centred(mesh);
+}
+
+Shape read_shape(const SceneReader& r, const json& v, const std::string& path);
+
+struct PartTarget {
+  CompoundPart part;
+  Quaternion orientation;
+};
+
+const KeyTable<PartTarget> kCompoundPartKeys = {
+    {.name = "shape",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, PartTarget& t) {
+       const Shape s = read_shape(r, x, p);
+       if (std::holds_alternative<Compound>(s)) r.fail(member(p, "compound"), "a compound's part cannot be a compound");
+       std::visit(Overloaded{[&](const Compound&) {}, [&](const auto& primitive) { t.part.shape = primitive; }}, s);
+     },
+     .required = true, .doc = {"object", "m", "**required**"}},
+    {.name = "position", .check = Check::vec3, .slot = SLOT(part.position), .bound = kLength,
+     .doc = {"vector", "m", "`[0, 0, 0]`"}},
+    {.name = "orientation", .check = Check::quaternion, .slot = SLOT(orientation),
+     .doc = {"[w, x, y, z]", "", "`[1, 0, 0, 0]`"}},
+    {.name = "material",
+     .read = [](const SceneReader& r, const json&, const std::string& p, PartTarget&) {
+       r.fail(p, "a compound's parts share their body's material: parts of different materials in one body "
+                 "are not supported (docs/scene-format.md \"Compounds\")");
+     },
+     .doc = {"string", "", "none"}},
+};
+
+Compound read_compound(const SceneReader& r, const json& v, const std::string& path) {
+  if (!v.is_array() || v.empty()) r.fail(path, "must be a non-empty array of parts {shape, position, orientation}");
+  std::vector<CompoundPart> parts;
+  for (size_t i = 0; i < v.size(); ++i) {
+    PartTarget t;
+    read_object(r, v[i], element(path, i), kCompoundPartKeys, t);
+    t.part.orientation = rotation_from_quaternion(t.orientation.w, t.orientation.x, t.orientation.y, t.orientation.z);
+    parts.push_back(std::move(t.part));
+  }
+  const Compound compound(std::move(parts));
+  if (const std::string e = validate_compound(compound); !e.empty()) r.fail(path, e);
+  return compound_centred(compound);
+}
+
 // Exactly one of these is present (read_shape).
 const KeyTable<Shape> kShapeKeys = {
     {.name = "sphere",
@@ -766,15 +894,22 @@ const KeyTable<Shape> kShapeKeys = {
        read_object(r, x, p, kCylinderKeys, c);
        s = c;
      }},
+    {.name = "mesh",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, Shape& s) { s = read_mesh(r, x, p); }},
+    {.name = "compound",
+     .read = [](const SceneReader& r, const json& x, const std::string& p, Shape& s) {
+       s = read_compound(r, x, p);
+     }},
 };
 
 Shape read_shape(const SceneReader& r, const json& v, const std::string& path) {
   check_unknown(r, v, path, kShapeKeys);
   if (v.size() != 1)
-    r.fail(path, "must have exactly one of the keys sphere, box, cylinder (it has " +
+    r.fail(path, "must have exactly one of the keys sphere, box, cylinder, mesh, compound (it has " +
                      std::to_string(v.size()) + ")");
   Shape shape;
   read_present(r, v, path, kShapeKeys, shape);
+  if (std::holds_alternative<Mesh>(shape) || std::holds_alternative<Compound>(shape)) return shape;  // checked
   if (const std::string e = validate_shape(shape); !e.empty()) r.fail(member(path, v.begin().key()), e);
   return shape;
 }
@@ -1411,6 +1546,7 @@ SceneDescription read_scene(const SceneReader& r, const json& root) {
   SceneTarget t;
   t.scene.file = r.file();
   read_object(r, root, "", kSceneKeys, t);
+  t.scene.notices = r.notices();
   return std::move(t.scene);
 }
 
@@ -1486,6 +1622,8 @@ std::vector<SceneKeyDoc> scene_key_docs() {
   add_key_docs(docs, "bodies[]", kBodyKeys);
   add_key_docs(docs, "bodies[].shape", kShapeKeys);
   add_key_docs(docs, "bodies[].shape.cylinder", kCylinderKeys);
+  add_key_docs(docs, "bodies[].shape.mesh", kMeshKeys);
+  add_key_docs(docs, "bodies[].shape.compound[]", kCompoundPartKeys);
   add_key_docs(docs, "bodies[].coils[].loop", kLoopKeys);
   add_key_docs(docs, "bodies[].coils[].solenoid", kSolenoidKeys);
   add_key_docs(docs, "bodies[].coils[].circular_coil", kCircularCoilKeys);

@@ -13,6 +13,36 @@ namespace odemag {
 
 namespace {
 
+// A variant's scene is written to its own folder (odemag sweep): mesh files
+// named relative to the base scene's folder become absolute paths, so that
+// the variant reads the same files (docs/scene-format.md "Meshes").
+void absolute_mesh_files(nlohmann::ordered_json& scene, const std::string& scene_file) {
+  const std::filesystem::path folder = std::filesystem::absolute(scene_file).parent_path();
+  auto fix_shape = [&](nlohmann::ordered_json& shape) {
+    if (!shape.is_object()) return;
+    const auto mesh = shape.find("mesh");
+    if (mesh == shape.end() || !mesh->is_object()) return;
+    const auto file = mesh->find("file");
+    if (file == mesh->end() || !file->is_string()) return;
+    const std::filesystem::path path = file->get<std::string>();
+    if (path.is_relative()) *file = (folder / path).lexically_normal().string();
+  };
+  const auto bodies = scene.find("bodies");
+  if (bodies == scene.end() || !bodies->is_array()) return;
+  for (nlohmann::ordered_json& body : *bodies) {
+    if (!body.is_object() || !body.contains("shape")) continue;
+    nlohmann::ordered_json& shape = body["shape"];
+    fix_shape(shape);
+    if (shape.is_object() && shape.contains("compound") && shape["compound"].is_array())
+      for (nlohmann::ordered_json& part : shape["compound"])
+        if (part.is_object() && part.contains("shape")) fix_shape(part["shape"]);
+  }
+}
+
+}  // namespace
+
+namespace {
+
 using json = nlohmann::ordered_json;  // keeps the scene's and the spec's key order
 
 // More variants than this is a mistake in the spec, not a sweep.
@@ -261,6 +291,7 @@ SweepVariant Sweep::variant(size_t i) const {
         described += (described.empty() ? "" : ", ") + o.path + " = " + o.value.dump();
       }
     }
+  absolute_mesh_files(scene, d.scene_file);
   v.scene_json = scene.dump(1) + "\n";
   try {
     v.scene = parse_scene(v.scene_json, d.scene_file);

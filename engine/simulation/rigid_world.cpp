@@ -91,7 +91,9 @@ RigidWorld::RigidWorld(const SceneDescription& scene)
     Body b;
     b.body = dBodyCreate(world_);
     const Vec3 half = shape_half_extents(d.shape);
-    b.skin = kSkinFraction * std::min({half.x, half.y, half.z});
+    // Trimeshes have no skin (docs/simulation.md "Meshes"), nor do compounds.
+    const bool primitive = !std::holds_alternative<Mesh>(d.shape) && !std::holds_alternative<Compound>(d.shape);
+    b.skin = primitive ? kSkinFraction * std::min({half.x, half.y, half.z}) : 0.0;
     const double skin = b.skin;
     dMass m;
     dMassSetZero(&m);
@@ -104,10 +106,34 @@ RigidWorld::RigidWorld(const SceneDescription& scene)
     } else if (const auto* c = std::get_if<Cylinder>(&d.shape)) {
       dMassSetCylinder(&m, d.density, 3, c->radius, c->length);
       b.geom = dCreateCylinder(space_, c->radius + skin, c->length + 2 * skin);
+    } else {
+      // Meshes and compounds: mass and inertia from the exact integrals
+      // (magnetics/cells/mesh.h), the centre of mass at the body's origin.
+      const double volume = shape_volume(d.shape);
+      const Mat3 J = shape_unit_inertia(d.shape);
+      dMassSetParameters(&m, d.density * volume, 0, 0, 0, d.density * J.m[0][0], d.density * J.m[1][1],
+                         d.density * J.m[2][2], d.density * J.m[0][1], d.density * J.m[0][2], d.density * J.m[1][2]);
+      if (const auto* mesh = std::get_if<Mesh>(&d.shape)) {
+        b.geom = trimesh_geom(*mesh);
+      } else {
+        // One geom per part, placed by its offset in the body frame.
+        const auto& parts = std::get<Compound>(d.shape).parts();
+        for (size_t k = 0; k < parts.size(); ++k) {
+          const dGeomID g = part_geom(parts[k].shape, 0.0);
+          dGeomSetBody(g, b.body);
+          dGeomSetOffsetPosition(g, parts[k].position.x, parts[k].position.y, parts[k].position.z);
+          dMatrix3 R{};
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) R[4 * i + j] = parts[k].orientation.m[i][j];
+          dGeomSetOffsetRotation(g, R);
+          if (k == 0) b.geom = g;
+          else b.windings.push_back(g);
+        }
+      }
     }
     dBodySetMass(b.body, &m);
     b.mass = m.mass;
-    dGeomSetBody(b.geom, b.body);
+    if (!dGeomGetBody(b.geom)) dGeomSetBody(b.geom, b.body);
     // The windings of its coils collide like its shape (winding_solids.h),
     // enlarged by the same skin.
     for (const CoilSource& coil : d.coils)
@@ -184,7 +210,34 @@ RigidWorld::~RigidWorld() {
   exact_step_.reset();  // gives the world back ODE's threading before it goes
   dJointGroupDestroy(contacts_);
   dSpaceDestroy(space_);  // destroys the geoms it holds
+  for (const auto& t : trimeshes_) dGeomTriMeshDataDestroy(t->data);
   dWorldDestroy(world_);  // destroys the bodies
+}
+
+dGeomID RigidWorld::trimesh_geom(const Mesh& mesh) {
+  auto store = std::make_unique<TriMeshStore>();
+  for (const Vec3& v : mesh.vertices()) store->vertices.insert(store->vertices.end(), {v.x, v.y, v.z, 0.0});
+  for (const auto& t : mesh.triangles())
+    for (int k = 0; k < 3; ++k) store->indices.push_back(static_cast<dTriIndex>(t[k]));
+  store->data = dGeomTriMeshDataCreate();
+  dGeomTriMeshDataBuildDouble(store->data, store->vertices.data(), 4 * sizeof(double),
+                              static_cast<int>(mesh.vertices().size()), store->indices.data(),
+                              static_cast<int>(store->indices.size()), 3 * sizeof(dTriIndex));
+  const dGeomID g = dCreateTriMesh(space_, store->data, nullptr, nullptr, nullptr);
+  trimeshes_.push_back(std::move(store));
+  return g;
+}
+
+dGeomID RigidWorld::part_geom(const PartShape& shape, double skin) {
+  return std::visit(Overloaded{
+                        [&](const Sphere& s) { return dCreateSphere(space_, s.radius + skin); },
+                        [&](const Box& x) {
+                          return dCreateBox(space_, x.size.x + 2 * skin, x.size.y + 2 * skin, x.size.z + 2 * skin);
+                        },
+                        [&](const Cylinder& c) { return dCreateCylinder(space_, c.radius + skin, c.length + 2 * skin); },
+                        [&](const Mesh& m) { return trimesh_geom(m); },
+                    },
+                    shape);
 }
 
 double RigidWorld::skin_of(dGeomID geom) const {

@@ -94,7 +94,9 @@ class RigidWorld : public RigidSubsteps {
   struct Body {
     dBodyID body = nullptr;
     dGeomID geom = nullptr;
-    std::vector<dGeomID> windings;  // the solids of its coils' windings (winding_solids.h)
+    // Its other geoms: a compound's parts after the first, the solids of its
+    // coils' windings (winding_solids.h).
+    std::vector<dGeomID> windings;
     bool kinematic = false;
     bool enabled = true;
     double mass = 0.0;
@@ -108,6 +110,19 @@ class RigidWorld : public RigidSubsteps {
   // Makes ODE's contact joints for the contacts of a geom pair.
   static void near_callback(void* data, dGeomID a, dGeomID b);
   double skin_of(dGeomID geom) const;
+
+  // A trimesh geom of the mesh (body frame), its data kept in trimeshes_.
+  dGeomID trimesh_geom(const Mesh& mesh);
+  // The geom of a primitive or a mesh.
+  dGeomID part_geom(const PartShape& shape, double skin);
+
+  // A trimesh's vertices and indices, which ODE reads in place.
+  struct TriMeshStore {
+    std::vector<double> vertices;  // x y z per vertex (ODE's dVector3 stride: 4)
+    std::vector<dTriIndex> indices;
+    dTriMeshDataID data = nullptr;
+  };
+  std::vector<std::unique_ptr<TriMeshStore>> trimeshes_;
 
   dWorldID world_ = nullptr;
   dSpaceID space_ = nullptr;

@@ -187,6 +187,9 @@ struct OutcomeDescription {
 
 struct SceneDescription {
   std::string file;            // path the scene was read from (for messages)
+  // What the loader changed or suspects (an inverted mesh turned outward,
+  // a mesh of unlikely size), one line each naming the key; odemag prints them.
+  std::vector<std::string> notices;
   std::string title;
   Vec3 gravity{0.0, 0.0, -9.81};
   Vec3 external_field;         // uniform H_E, A/m

@@ -6,7 +6,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "magnetics/cells/compound.h"
 #include "magnetics/cells/demag_tensor.h"
+#include "magnetics/cells/mesh.h"
 #include "magnetics/kernels/cell_field.h"
 #include "odemag/constants.h"
 
@@ -14,10 +16,7 @@ namespace odemag {
 
 namespace {
 
-// Volume and first moments (integrals of x, y, z) of a region.
-struct Moments {
-  double v = 0.0, x = 0.0, y = 0.0, z = 0.0;
-};
+using Moments = VolumeMoments;
 
 // Area and first moments (integrals of x and y) of the rectangle [x0, x1] x
 // [y0, y1] inside the disc x^2 + y^2 <= r^2, in closed form: in x the chord
@@ -168,12 +167,16 @@ Moments box_in_shape(const Shape& shape, const Vec3& lo, const Vec3& hi) {
             m.x = d.x * (v - u), m.y = d.y * (v - u), m.z = m.v * 0.5 * (u + v);
             return m;
           },
+          [&](const Mesh& m) { return mesh_box_moments(m, lo, hi); },
+          [&](const Compound& c) { return compound_box_moments(c, lo, hi); },
       },
       shape);
 }
 
 // True when the whole box [lo, hi] lies inside the shape (to tol).
 bool box_inside_shape(const Shape& shape, const Vec3& lo, const Vec3& hi, double tol) {
+  if (const Mesh* m = std::get_if<Mesh>(&shape)) return mesh_box_inside(*m, lo, hi);
+  if (const Compound* c = std::get_if<Compound>(&shape)) return compound_box_inside(*c, lo, hi);
   const Vec3 far{std::max(std::fabs(lo.x), std::fabs(hi.x)), std::max(std::fabs(lo.y), std::fabs(hi.y)),
                  std::max(std::fabs(lo.z), std::fabs(hi.z))};
   return shape_contains(shape, far, tol);
@@ -190,6 +193,8 @@ double depth_inside(const Shape& shape, const Vec3& p) {
                         [&](const Cylinder& c) {
                           return std::min(c.radius - std::hypot(p.x, p.y), 0.5 * c.length - std::fabs(p.z));
                         },
+                        [&](const Mesh& m) { return norm(mesh_closest_point(m, p) - p); },
+                        [&](const Compound& c) { return compound_depth(c, p); },
                     },
                     shape);
 }
@@ -302,6 +307,12 @@ void cylinder_demag_tensor(double a, double c, const Vec3& p, double n[6]) {
 }
 
 }  // namespace
+
+VolumeMoments shape_box_moments(const Shape& shape, const Vec3& lo, const Vec3& hi) {
+  return box_in_shape(shape, lo, hi);
+}
+
+double shape_depth(const Shape& shape, const Vec3& p) { return depth_inside(shape, p); }
 
 namespace {
 
@@ -610,6 +621,8 @@ void uniform_demag_over_cell(const Shape& shape, const CellSet& cells, int i, do
                      for (int a = 0; a < 6; ++a) n[a] += g3w[w] * t[a];
                    }
                  },
+                 [&](const Mesh& m) { mesh_demag_tensor(m, cells.local_positions[i], n); },
+                 [&](const Compound& c) { compound_demag_tensor(c, cells.local_positions[i], n); },
              },
              shape);
 }

@@ -192,12 +192,22 @@ inline constexpr double kMinCellShare = 1e-9;
 // Extent (in cells, every axis) from which a responsive body has volume-share cells.
 inline constexpr double kMinVolumeShareExtent = 2.0;
 
+// Volume and first moments of the box [lo, hi] inside the shape (body frame):
+// closed forms for balls, boxes and cylinders, magnetics/cells/mesh.h and
+// compound.h for meshes and compounds.
+struct VolumeMoments;
+VolumeMoments shape_box_moments(const Shape& shape, const Vec3& lo, const Vec3& hi);
+// Distance from a point inside the shape to its surface.
+double shape_depth(const Shape& shape, const Vec3& p);
+
 // The demagnetising tensor of the uniformly magnetized shape, averaged over
 // cell i's part of it: H = -N M there for a body of uniform magnetization M
 // (body frame, six components xx, xy, xz, yy, yz, zz; trace 1). Exactly I/3
 // for a ball; for a cylinder the field of its charged end discs and side
 // (one-dimensional quadratures) at 3 Gauss points along the axis through the
-// centroid of the cell's cross-section. Boxes have no volume-share cells
+// centroid of the cell's cross-section; for a mesh or a compound the field of
+// its face charges (magnetics/cells/mesh.h mesh_demag_tensor) at the cell's
+// centroid. Boxes have no volume-share cells
 // (uses_volume_shares): std::logic_error.
 void uniform_demag_over_cell(const Shape& shape, const CellSet& cells, int i, double n[6]);
 

@@ -107,6 +107,7 @@ std::vector<SceneKeyDoc> keys_of(const std::string& section) {
 const std::map<std::string, std::string> kKeyTables = {
     {"", "Top level"},           {"materials.permanent", "permanent"}, {"materials.soft", "soft"}, {"materials.linear", "linear"},
     {"materials.inert", "inert"}, {"bodies[]", "Bodies"},              {"solver", "solver"},
+    {"bodies[].shape.mesh", "Meshes"}, {"bodies[].shape.compound[]", "Compounds"},
     {"simulation", "simulation"}, {"simulation.contact", "contact"},
     {"camera", "camera"},
     {"render", "render"},         {"outcomes[]", "outcomes"},           {"joints[]", "joints"},

@@ -162,6 +162,23 @@ TEST_F(Sweep, OutThatIsAFileOrAMissingGatherFolderExitsTwo) {
   EXPECT_NE(below.err.find("is not a directory"), std::string::npos) << below.err;
 }
 
+// A scene with a mesh file named relative to its folder: each variant,
+// written to its own folder, names the file by its absolute path and runs.
+TEST_F(Sweep, VariantsReadTheBaseScenesMeshFiles) {
+  fs::create_directories(dir_ / "meshes");
+  fs::copy_file(fs::path(ODEMAG_SOURCE_DIR) / "examples/meshes/needle.obj", dir_ / "meshes/needle.obj");
+  std::string base = read_file(fs::path(ODEMAG_SOURCE_DIR) / "examples/compass_needle_mesh.json");
+  write("base.json", base);
+  const fs::path s = write("spec.json", R"({"scene": "base.json", "set": {"simulation.duration": 0.05},
+    "grid": {"external_field[0]": [1000, 2000]}, "collect": ["steps"], "run": ["--backend", "cpu"]})");
+  const ProgramRun r = sweep(s);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json scene = json::parse(read_file(dir_ / "out" / "variants" / "0001" / "scene.json"));
+  EXPECT_EQ(scene["bodies"][1]["shape"]["mesh"]["file"].get<std::string>(),
+            fs::absolute(dir_ / "meshes/needle.obj").lexically_normal().string());
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "variants" / "0001" / "summary.json"));
+}
+
 TEST_F(Sweep, GridExpandsInOrderTheFirstKeySlowest) {
   const ProgramRun r = sweep(spec(R"("grid": {"materials.steel.susceptibility": [10, 100, 1000],
                                               "bodies[5].position[2]": [0.005, 0.006]})"),

@@ -392,5 +392,45 @@ TEST(CraneElectromagnetScene, NoBallEntersTheWinding) {
   EXPECT_GT(closest, 0.25 * R);
 }
 
+// The mesh examples (examples/meshes/make_meshes.py writes their OBJ files).
+std::string example_path(const std::string& name) { return std::string(ODEMAG_SOURCE_DIR) + "/examples/" + name + ".json"; }
+
+// examples/horseshoe_lift.json: the horseshoe, lowered to 2 mm above two
+// balls under its tips and raised again, takes them (and the third ball,
+// pulled over the table) up with it.
+TEST(MeshExamples, HorseshoeLiftsTheBalls) {
+  Simulation sim(load_scene(example_path("horseshoe_lift")), make_cpu_backend(1));
+  sim.advance_to(sim.scene().simulation.duration);
+  sim.finish();
+  EXPECT_GE(outcome(sim, "balls_lifted"), 2.0);
+  for (int b = 0; b < sim.world().body_count(); ++b) EXPECT_TRUE(sim.finite_state(b)) << b;
+}
+
+// examples/key_to_magnet.json: the key slides to the magnet and stays on it.
+TEST(MeshExamples, KeySlidesToTheMagnet) {
+  Simulation sim(load_scene(example_path("key_to_magnet")), make_cpu_backend(1));
+  const int key = sim.scene().find_body("key");
+  const double start = sim.world().pose(key).position.x;
+  sim.advance_to(sim.scene().simulation.duration);
+  sim.finish();
+  EXPECT_GT(sim.world().pose(key).position.x - start, 0.005);
+  EXPECT_LT(norm(sim.world().velocity(key)), 0.01);
+  EXPECT_GT(sim.magnetics().force(key).x, 1.0);
+}
+
+// examples/compass_needle_mesh.json: the needle, released at 60 degrees to
+// the field, swings towards it.
+TEST(MeshExamples, CompassNeedleTurnsToTheField) {
+  Simulation sim(load_scene(example_path("compass_needle_mesh")), make_cpu_backend(1));
+  const int needle = sim.scene().find_body("needle");
+  double smallest = kPi;
+  while (sim.time() < sim.scene().simulation.duration) {
+    sim.step();
+    const Mat3& r = sim.world().pose(needle).rotation;
+    smallest = std::min(smallest, std::fabs(std::atan2(r.m[1][0], r.m[0][0])));
+  }
+  EXPECT_LT(smallest, 0.1);
+}
+
 }  // namespace
 }  // namespace odemag

@@ -146,6 +146,50 @@ TEST(RenderMagnet, PolesColourTheirHalves) {
   EXPECT_TRUE(blue_dominant(right2));
 }
 
+// A triangle surface (a mesh body) is drawn lit by its normals and split
+// into its pole colours like a primitive: a box's 12 triangles, the face
+// towards the camera lit, the pole halves red and blue.
+TEST(RenderMagnet, SurfaceMagnetSplitsAndIsLit) {
+  auto surface = std::make_shared<RenderSurface>();
+  const double e[3] = {0.1, 0.025, 0.025};
+  // Two triangles per face, counter-clockwise from outside, flat normals.
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side : {-1, 1}) {
+      const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+      double q[4][3];
+      const double cu[4] = {-1, 1, 1, -1}, cv[4] = {-1, -1, 1, 1};
+      for (int k = 0; k < 4; ++k) {
+        q[k][axis] = side * e[axis];
+        q[k][u] = cu[k] * e[u];
+        q[k][v] = side * cv[k] * e[v];
+      }
+      for (int k : {0, 1, 2, 0, 2, 3}) {
+        surface->positions.insert(surface->positions.end(),
+                                  {static_cast<float>(q[k][0]), static_cast<float>(q[k][1]), static_cast<float>(q[k][2])});
+        float n[3] = {0, 0, 0};
+        n[axis] = static_cast<float>(side);
+        surface->normals.insert(surface->normals.end(), {n[0], n[1], n[2]});
+      }
+    }
+  surface->radius = 0.11;
+  RenderFrame scene = front_scene();
+  RenderPrimitive magnet = RenderPrimitive::of_surface({0, 0, 0}, surface, Mat3{}, {0.5f, 0.5f, 0.5f});
+  magnet.pole_axis = {1.0, 0.0, 0.0};
+  scene.primitives.push_back(magnet);
+  OffscreenRenderer renderer(kW, kH);
+  const auto rgb = renderer.render(scene);
+  double left = 0, right = 0, row = 0;
+  project_front({-0.06, -0.025, 0.0}, &left, &row);
+  project_front({0.06, -0.025, 0.0}, &right, &row);
+  const int r = static_cast<int>(std::lround(row));
+  const Pixel south = at(rgb, kW, static_cast<int>(std::lround(left)), r);
+  const Pixel north = at(rgb, kW, static_cast<int>(std::lround(right)), r);
+  EXPECT_TRUE(blue_dominant(south)) << south.r << "," << south.g << "," << south.b;
+  EXPECT_GT(north.r, 2 * north.b) << north.r << "," << north.g << "," << north.b;
+  EXPECT_GT(north.r, 2 * north.g);
+  EXPECT_GT(north.r, 60);  // lit: the face's normal points at the camera
+}
+
 TEST(RenderMagnet, CylinderAndSphereMagnetsSplit) {
   for (const auto kind : {RenderPrimitive::Kind::cylinder, RenderPrimitive::Kind::sphere}) {
     RenderFrame scene = front_scene();

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "magnetics/relax/relax.h"
+#include "tests/support/mesh_builders.h"
 #include "tests/support/scene_builders.h"
 #include "engine/simulation/rigid_world.h"
 
@@ -37,6 +38,35 @@ SceneDescription small_scene() {
   s.camera.width = 96;
   s.camera.height = 72;
   return s;
+}
+
+// A mesh magnet and a compound are drawn as surfaces (three vertices per
+// triangle, unit normals), the magnet split by its magnetization.
+TEST(SceneView, MeshesAndCompoundsAreSurfaces) {
+  SceneDescription scene = small_scene();
+  scene.bodies[0].shape = test::box_surface_mesh({0.04, 0.01, 0.01}, 2);
+  std::vector<CompoundPart> parts(2);
+  parts[0].shape = Box{{0.01, 0.02, 0.02}};
+  parts[0].position = {-0.005, 0, 0};
+  parts[1].shape = Sphere{0.008};
+  parts[1].position = {0.008, 0, 0};
+  scene.bodies[2].shape = Compound(parts);
+  Simulation sim(scene, make_cpu_backend(1));
+  sim.step();
+  const RenderFrame view = render_scene_of(sim, ViewOptions{}, nullptr);
+  ASSERT_EQ(view.primitives.size(), 3u);
+  for (int k : {0, 2}) {
+    const RenderPrimitive& p = view.primitives[k];
+    ASSERT_EQ(p.kind, RenderPrimitive::Kind::surface);
+    ASSERT_TRUE(p.surface);
+    ASSERT_EQ(p.surface->positions.size() % 9, 0u);
+    ASSERT_EQ(p.surface->normals.size(), p.surface->positions.size());
+    for (size_t i = 0; i < p.surface->normals.size(); i += 3)
+      EXPECT_NEAR(std::hypot(p.surface->normals[i], p.surface->normals[i + 1], p.surface->normals[i + 2]), 1.0, 1e-5);
+  }
+  EXPECT_EQ(view.primitives[0].surface->positions.size(), 9u * 48u);  // 8 triangles per face
+  EXPECT_GT(view.primitives[0].pole_axis.x, 0.99);
+  EXPECT_NEAR(view.primitives[0].surface->radius, std::sqrt(0.02 * 0.02 + 2 * 0.005 * 0.005), 1e-9);
 }
 
 TEST(SceneView, MagnetsSplitAlongTheirMagnetizationOthersInTheirColours) {
