@@ -21,10 +21,67 @@ BodyPose scene_pose(const BodyDescription& body) {
 bool takes_contact_zones(const SceneDescription& scene, int b) {
   const BodyDescription& body = scene.bodies[b];
   const auto material = scene.materials.find(body.material);
-  return std::holds_alternative<Sphere>(body.shape) && material != scene.materials.end() &&
-         has_positive_susceptibility(material->second) &&
+  return (std::holds_alternative<Sphere>(body.shape) || std::holds_alternative<Box>(body.shape)) &&
+         material != scene.materials.end() && has_positive_susceptibility(material->second) &&
          uses_volume_shares(body.shape, scene.body_cell_size(b));
 }
+
+namespace {
+
+// Whether another body of the scene could give body b zones: a magnetized or
+// soft body for a ball, another such box for a box (contact_zones).
+bool has_zone_partner(const SceneDescription& scene, int b) {
+  const bool box = std::holds_alternative<Box>(scene.bodies[b].shape);
+  for (size_t o = 0; o < scene.bodies.size(); ++o) {
+    if (static_cast<int>(o) == b) continue;
+    const auto material = scene.materials.find(scene.bodies[o].material);
+    if (material == scene.materials.end() || is_inert(material->second)) continue;
+    if (!box || std::holds_alternative<Box>(scene.bodies[o].shape)) return true;
+  }
+  return false;
+}
+
+// The zone of box b facing box o across a gap of at most kBoxContactGap h
+// (none where they touch, overlap, meet only at an edge, or lie farther
+// apart): the patch of b's face that o's box covers, refined to h/2 within
+// its half diagonal of the patch's centre (docs/model.md "Refined contact
+// zones").
+bool box_facing_zone(const Box& box, const BodyPose& pose, const Box& other, const BodyPose& other_pose, double h,
+                     RefinedZone& zone) {
+  const Vec3 e = 0.5 * box.size, f = 0.5 * other.size;
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};  // o's box in b's frame
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner{(c & 1 ? 1 : -1) * f.x, (c & 2 ? 1 : -1) * f.y, (c & 4 ? 1 : -1) * f.z};
+    const Vec3 p = pose.rotation.transpose_times(other_pose.position + other_pose.rotation * corner - pose.position);
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  }
+  int axis = -1;
+  double gap = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double s = std::max({lo[k] - e[k], -e[k] - hi[k], 0.0});
+    if (s > 0.0) {
+      if (axis >= 0) return false;  // apart along two axes: an edge or a corner
+      axis = k, gap = s;
+    }
+  }
+  if (axis < 0 || gap > kBoxContactGap * h) return false;
+  Vec3 point;
+  double half_diagonal2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    if (k == axis) {
+      point[k] = lo[k] > e[k] ? e[k] : -e[k];
+      continue;
+    }
+    const double a = std::max(lo[k], -e[k]), c = std::min(hi[k], e[k]);
+    if (!(c > a)) return false;  // the faces do not overlap
+    point[k] = 0.5 * (a + c);
+    half_diagonal2 += 0.25 * (c - a) * (c - a);
+  }
+  zone = {point, {std::sqrt(half_diagonal2)}};
+  return true;
+}
+
+}  // namespace
 
 std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vector<BodyPose>& poses,
                                  const std::vector<uint8_t>& active, int b) {
@@ -59,6 +116,19 @@ std::vector<RefinedZone> contact_zones(const SceneDescription& scene,
                                        const std::vector<uint8_t>& active, int b) {
   const double h = scene.body_cell_size(b);
   std::vector<RefinedZone> zones;
+  if (const auto* box = std::get_if<Box>(&scene.bodies[b].shape)) {
+    if (!takes_contact_zones(scene, b)) return zones;
+    for (size_t o = 0; o < scene.bodies.size(); ++o) {
+      const auto* other = std::get_if<Box>(&scene.bodies[o].shape);
+      const auto material = scene.materials.find(scene.bodies[o].material);
+      if (static_cast<int>(o) == b || !other || material == scene.materials.end() || is_inert(material->second) ||
+          (!active.empty() && !active[o]))
+        continue;
+      RefinedZone zone;
+      if (box_facing_zone(*box, poses[b], *other, poses[o], h, zone)) zones.push_back(zone);
+    }
+    return zones;
+  }
   for (const Vec3& point : contact_points(scene, poses, active, b))
     zones.push_back({point, default_refinement_radii(h)});
   return zones;
@@ -208,9 +278,9 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene) {
 
 std::string cpu_only_feature(const SceneDescription& scene) {
   if (scene.solver.graded_cells) return "graded cells (solver.graded_cells)";
-  // A lattice ball that may get zones, now or when a run moves them.
+  // A lattice body that may get zones, now or when a run moves them.
   for (size_t b = 0; scene.solver.contact_refinement && b < scene.bodies.size(); ++b)
-    if (takes_contact_zones(scene, static_cast<int>(b)))
+    if (takes_contact_zones(scene, static_cast<int>(b)) && has_zone_partner(scene, static_cast<int>(b)))
       return "refined contact zones (solver.contact_refinement)";
   for (const auto& [name, material] : scene.materials)
     if (const auto* soft = std::get_if<SoftMaterial>(&material); soft && !soft->bh_curve.empty())

@@ -54,17 +54,12 @@ SceneCellCounts count_scene_cells(const SceneDescription& scene);
 std::vector<std::string> scene_notices(const SceneDescription& scene);
 
 // The refined contact zones of every body, indexed as scene.bodies
-// (docs/model.md "Refined contact zones"). With solver.contact_refinement, a
-// lattice ball of a material with positive susceptibility (soft, or a magnet
-// with recoil) gets one zone, with
-// default_refinement_radii, at its surface point nearest each other
-// magnetized or soft body whose nearest point lies within
-// kContactRefinementGap radii of its surface, at the scene's poses (the
-// zones stay where they are in the body frame). Every list is empty otherwise.
+// (docs/model.md "Refined contact zones"), with solver.contact_refinement, at
+// the scene's poses (the zones stay where they are in the body frame):
+// contact_zones of every body. Empty lists otherwise.
 std::vector<std::vector<RefinedZone>> scene_contact_zones(const SceneDescription& scene);
-
-// Whether body b may get refined contact zones: a lattice ball (a sphere of
-// volume-share cells) of a material with positive susceptibility. Does not
+// Whether body b may get refined contact zones: a lattice ball or box
+// (volume-share cells) of a material with positive susceptibility. Does not
 // look at solver.contact_refinement.
 bool takes_contact_zones(const SceneDescription& scene, int b);
 
@@ -77,10 +72,17 @@ bool takes_contact_zones(const SceneDescription& scene, int b);
 std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vector<BodyPose>& poses,
                                  const std::vector<uint8_t>& active, int b);
 inline constexpr double kContactRefinementGap = 0.5;
+// Two boxes facing each other across a gap of at most this many cells of the
+// refined box get a zone on its facing patch (contact_zones).
+inline constexpr double kBoxContactGap = 1.0;
 
-// Body b's zones at the given poses: one at each of its contact_points, with
-// default_refinement_radii. scene_contact_zones is this at the scene's
-// poses; Simulation::follow_contact_zones at a step's end.
+// Body b's zones at the given poses: a ball's one at each of its
+// contact_points, with default_refinement_radii; a box's one on each patch of
+// its faces that another magnetized or soft box faces across a gap of at most
+// kBoxContactGap cells (not where they touch: the near field joins touching
+// aligned lattices), refined to h/2 within the patch's half diagonal of its
+// centre. scene_contact_zones is this at the scene's poses;
+// Simulation::follow_contact_zones at a step's end.
 std::vector<RefinedZone> contact_zones(const SceneDescription& scene,
                                        const std::vector<BodyPose>& poses,
                                        const std::vector<uint8_t>& active, int b);

@@ -536,6 +536,7 @@ CellSet make_refined_cells(const Shape& shape, double cell_size, const std::vect
   }
   const double h = cell_size;
   const std::array<int, 3> n = volume_share_extent(shape, h);
+  const Box* box = std::get_if<Box>(&shape);
   CellSet cells;
   // A cube of edge a at level l is split when it comes within radii[l] of a zone's point.
   auto split = [&](const Vec3& site, double a, size_t level) {
@@ -565,6 +566,13 @@ CellSet make_refined_cells(const Shape& shape, double cell_size, const std::vect
     }
     const ShareCell c = share_cell(shape, site, a);
     if (c.volume == 0.0) return;
+    if (box) {  // the part sub-cube ∩ box, a cuboid about the centroid
+      Vec3 half;
+      for (int k = 0; k < 3; ++k)
+        half[k] = 0.5 * (std::min(site[k] + 0.5 * a, 0.5 * box->size[k]) -
+                         std::max(site[k] - 0.5 * a, -0.5 * box->size[k]));
+      cells.part_halves.push_back(half);
+    }
     if (cells.size() >= kMaxRefinedCells)
       throw std::invalid_argument("refined zones give more than " + std::to_string(kMaxRefinedCells) +
                                   " cells (their intra-body tensors take 48 bytes per pair of cells)");

@@ -73,9 +73,9 @@ struct CellSet {
   std::vector<Vec3> cube_centres;
   // A box's cells: per cell the half extents of its part of the box, a
   // cuboid centred on the cell point (cube ∩ box about its centroid for
-  // volume-share cells; the layer of a thin box's centre-inside cells), or
-  // the cube of edge h where its part is no cuboid about the point. Empty for
-  // other bodies.
+  // volume-share and refined cells; the layer of a thin box's centre-inside
+  // cells), or the cube of edge h where its part is no cuboid about the
+  // point. Empty for other bodies.
   std::vector<Vec3> part_halves;
 
   int size() const { return static_cast<int>(local_positions.size()); }
@@ -112,6 +112,9 @@ struct CellSet {
     return cell_volume;
   }
   // True when cell i's solid is the cube of edge h (solid_half h/2).
+  // True when every cell's solid is the part of the body it stands for (a
+  // box's), so that fields between bodies can take the solids' exact tensors.
+  bool exact_solids() const { return !part_halves.empty(); }
   bool solid_is_cube(int i) const {
     if (graded || refined) return false;
     if (part_halves.empty()) return true;

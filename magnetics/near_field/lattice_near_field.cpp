@@ -389,11 +389,12 @@ class LatticeNearField final : public NearFieldTerm {
     std::vector<int> eligible;
     for (int b = 0; b < model.body_count(); ++b) {
       const MagneticBody& body = model.body(b);
-      // Graded bodies and refined zones (CellSet::mixed_sizes) are not cubes on
-      // one lattice: they keep the point dipoles between bodies (docs/model.md
-      // "Graded cells", "Refined contact zones").
+      // Graded bodies and a curved body's refined zones (CellSet::mixed_sizes)
+      // are not solids on one lattice: they keep the point dipoles between
+      // bodies (docs/model.md "Graded cells", "Refined contact zones"). A
+      // box's refined cells are exact cuboid parts of it (exact_solids).
       if (body.inert() || !state.active[b] || body.cells.spacing <= 0.0 || body.cell_count() < 3 ||
-          body.cells.mixed_sizes())
+          (body.cells.mixed_sizes() && !(body.cells.refined && body.cells.exact_solids())))
         continue;
       LatticeBody& lb = bodies_[b];
       const double h = body.cells.spacing;

@@ -208,14 +208,17 @@ TEST_F(Cli, ContactRefinementKeyRefinesTouchingLatticeBalls) {
   const ProgramRun cuda = odemag("solve " + shell_quote(scene(true).string()) + " --backend cuda");
   EXPECT_EQ(cuda.status, 2);
   EXPECT_NE(cuda.err.find("contact_refinement"), std::string::npos) << cuda.err;
-  // A lattice ball with no contact yet: a run may give it zones later, which
-  // the CUDA backend cannot take, so it is refused from the start.
+  // A lattice ball with no contact yet, another magnetized body far away: a
+  // run may give it zones later, which the CUDA backend cannot take, so it
+  // is refused from the start.
   const ProgramRun lonely = odemag(
       "run " +
       shell_quote(write("lonely.json", R"({"materials": {"iron": {"type": "soft", "saturation": 1e6,
                                                                           "susceptibility": 100}},
                                                   "bodies": [{"name": "b", "shape": {"sphere": 0.005},
-                                                              "material": "iron", "cell_size": 0.0011}],
+                                                              "material": "iron", "cell_size": 0.0011},
+                                                             {"name": "c", "shape": {"sphere": 0.005},
+                                                              "material": "iron", "position": [0.1, 0, 0]}],
                                                   "solver": {"contact_refinement": true}})")
                       .string()) +
       " --backend cuda --duration 0.001 --frames no --out " +
