@@ -195,7 +195,7 @@ TEST(MagneticForcesApi, EveryIndexCallThrowsNamingItselfAndTheIndex) {
 }
 
 // A lattice beyond kMaxBodyLatticePoints is refused before a cell is made:
-// a 1 m box at 1 um (1e18 points) used to hang.
+// a 1 m box at 1 um (1e18 points) would take hours and all memory.
 TEST(MagneticForcesApi, LatticeBeyondTheLimitThrowsAtOnce) {
   MagneticForces magnetics;
   const auto t0 = std::chrono::steady_clock::now();
