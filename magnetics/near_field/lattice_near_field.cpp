@@ -188,6 +188,25 @@ void rotate_symmetric(const Mat3& R, const double s[6], double out[6]) {
   }
 }
 
+// The smoothed onset of overlap of two aligned solids with overlaps p_k
+// (dp_k = dp_k / dd_k) along each axis: s_k = D(p_k) q_i q_j, subtracted from
+// N_kk, q the edge ramps of the overlaps, and ds[k][m] = ds_k / dd_m.
+void overlap_onset(const double p[3], const double dp[3], double h, double s[3], double ds[3][3]) {
+  double q[3], dq[3];
+  for (int k = 0; k < 3; ++k) q[k] = edge_ramp(p[k], kEdgeWidth * h, dq[k]), dq[k] *= dp[k];
+  for (int k = 0; k < 3; ++k) {
+    s[k] = 0.0, ds[k][0] = ds[k][1] = ds[k][2] = 0.0;
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    double dD_dp;
+    const double o = onset(p[k], kOnsetWidth * h, dD_dp);
+    if (o == 0.0 && dD_dp == 0.0) continue;
+    s[k] = o * q[i] * q[j];
+    ds[k][k] = dD_dp * dp[k] * q[i] * q[j];
+    ds[k][i] = o * dq[i] * q[j];
+    ds[k][j] = o * q[i] * dq[j];
+  }
+}
+
 // The tensor of two aligned cubes of edge h acting on moments, H = D mu, at the
 // offset d of their centres in their frame: D = -N_s(d) / h^3 (header comment), and, when
 // dD is not null, its gradient dD[k] = dD / dd_k.
@@ -203,27 +222,16 @@ void cube_pair_tensor(const double d[3], double h, double volume, double D[6], d
     p[k] = std::max(h - a, 0.0);
     dp[k] = a < h ? -sign : (a == h ? -0.5 * sign : 0.0);
   }
-  double q[3], dq[3];
-  for (int k = 0; k < 3; ++k) q[k] = edge_ramp(p[k], kEdgeWidth * h, dq[k]), dq[k] *= dp[k];
-  // s_k = D(p_k) q_i q_j / h^3, subtracted from N_kk, and ds[k][m] = ds_k / dd_m.
+  // s_k / h^3 subtracted from N_kk (overlap_onset).
+  double s[3], ds[3][3];
+  overlap_onset(p, dp, h, s, ds);
   const double h3 = h * h * h;
-  double s[3] = {}, ds[3][3] = {};
-  for (int k = 0; k < 3; ++k) {
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    double dD_dp;
-    const double o = onset(p[k], kOnsetWidth * h, dD_dp);
-    if (o == 0.0 && dD_dp == 0.0) continue;
-    s[k] = o * q[i] * q[j] / h3;
-    ds[k][k] = dD_dp * dp[k] * q[i] * q[j] / h3;
-    ds[k][i] = o * dq[i] * q[j] / h3;
-    ds[k][j] = o * q[i] * dq[j] / h3;
-  }
   for (int m = 0; m < 6; ++m) D[m] = -n[m] / volume;
-  for (int k = 0; k < 3; ++k) D[kDiagonal[k]] += s[k] / volume;
+  for (int k = 0; k < 3; ++k) D[kDiagonal[k]] += s[k] / (h3 * volume);
   if (!dD) return;
   for (int m = 0; m < 3; ++m) {
     for (int c = 0; c < 6; ++c) dD[m][c] = -dn[m][c] / volume;
-    for (int k = 0; k < 3; ++k) dD[m][kDiagonal[k]] += ds[k][m] / volume;
+    for (int k = 0; k < 3; ++k) dD[m][kDiagonal[k]] += ds[k][m] / (h3 * volume);
   }
 }
 
@@ -247,19 +255,8 @@ void solid_pair_tensor(const double d[3], const double a[3], const double b[3], 
     p[k] = std::clamp(reach - s, 0.0, full);
     dp[k] = (s < reach && reach - s < full) ? -sign : 0.0;
   }
-  double q[3], dq[3];
-  for (int k = 0; k < 3; ++k) q[k] = edge_ramp(p[k], kEdgeWidth * h, dq[k]), dq[k] *= dp[k];
-  double s[3] = {}, ds[3][3] = {};
-  for (int k = 0; k < 3; ++k) {
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    double dD_dp;
-    const double o = onset(p[k], kOnsetWidth * h, dD_dp);
-    if (o == 0.0 && dD_dp == 0.0) continue;
-    s[k] = o * q[i] * q[j];
-    ds[k][k] = dD_dp * dp[k] * q[i] * q[j];
-    ds[k][i] = o * dq[i] * q[j];
-    ds[k][j] = o * q[i] * dq[j];
-  }
+  double s[3], ds[3][3];
+  overlap_onset(p, dp, h, s, ds);
   for (int m = 0; m < 6; ++m) D[m] = -n[m] / Vb;
   for (int k = 0; k < 3; ++k) D[kDiagonal[k]] += s[k] / (Va * Vb);
   if (!dD) return;
