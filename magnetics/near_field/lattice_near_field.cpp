@@ -377,6 +377,10 @@ struct LatticeBody {
 class LatticeNearField final : public NearFieldTerm {
  public:
   void build(const MagneticModel& model, const MagneticState& state) override {
+    // The last build's pairs: their frame tensors are taken again where every
+    // input is the same (reused_frames).
+    std::swap(links_, previous_links_);
+    std::swap(pairs_, previous_pairs_);
     links_.clear();
     pairs_.clear();
     bodies_.assign(model.body_count(), {});
@@ -541,6 +545,15 @@ class LatticeNearField final : public NearFieldTerm {
     const std::vector<int> cells_a = near_cells(A, lb), cells_b = near_cells(B, la);
     const int link_index = static_cast<int>(links_.size());
     const std::size_t first_pair = pairs_.size();
+    // The last build's pairs of the same two bodies at the same rotations, in
+    // the same (i, j) order as the loop below.
+    int previous_link = -1;
+    for (std::size_t k = 0; k < previous_links_.size(); ++k) {
+      const BodyLink& o = previous_links_[k];
+      if (o.a == a && o.b == b && o.h == h && same_rotation(o.rotation_a, Ra) && same_rotation(o.rotation_b, Rb))
+        previous_link = static_cast<int>(k);
+    }
+    std::size_t previous = 0;
     for (int i : cells_a)
       for (int j : cells_b) {
         const Vec3 d = state.cell_position[i] - state.cell_position[j];
@@ -555,8 +568,10 @@ class LatticeNearField final : public NearFieldTerm {
         const bool cubes = ca.solid_is_cube(ia) && cb.solid_is_cube(jb);
         p.solids_a = {cubes, ca.solid_half(ia), permuted_half(P, cb.solid_half(jb))};
         p.solids_b = {cubes, permuted_half(P.transposed(), ca.solid_half(ia)), cb.solid_half(jb)};
-        p.frame_a = local_tensor(Ra, d, h, p.volume, p.solids_a);
-        p.frame_b = link.same_frames ? p.frame_a : local_tensor(Rb, d, h, p.volume, p.solids_b);
+        if (!reused_frames(previous_link, previous, p)) {
+          p.frame_a = local_tensor(Ra, d, h, p.volume, p.solids_a);
+          p.frame_b = link.same_frames ? p.frame_a : local_tensor(Rb, d, h, p.volume, p.solids_b);
+        }
         double ta[6], tb[6];
         rotate_symmetric(Ra, p.frame_a.D, ta);
         rotate_symmetric(Rb, p.frame_b.D, tb);
@@ -569,8 +584,35 @@ class LatticeNearField final : public NearFieldTerm {
     if (pairs_.size() > first_pair) links_.push_back(link);
   }
 
-  std::vector<BodyLink> links_;
-  std::vector<CellPair> pairs_;
+  // Whether the last build's pair of link previous_link with p's cells had
+  // every input of its frame tensors equal to p's, bit for bit (offset,
+  // volume, solids; the link's rotations are equal): then p takes its frame
+  // tensors, which local_tensor would compute anew to the same bits. Pairs
+  // come in (i, j) order in both builds; `cursor` walks the last one's.
+  bool reused_frames(int previous_link, std::size_t& cursor, CellPair& p) const {
+    if (previous_link < 0) return false;
+    while (cursor < previous_pairs_.size() &&
+           (previous_pairs_[cursor].link < previous_link ||
+            (previous_pairs_[cursor].link == previous_link &&
+             (previous_pairs_[cursor].i < p.i || (previous_pairs_[cursor].i == p.i && previous_pairs_[cursor].j < p.j)))))
+      ++cursor;
+    if (cursor >= previous_pairs_.size()) return false;
+    const CellPair& o = previous_pairs_[cursor];
+    if (o.link != previous_link || o.i != p.i || o.j != p.j || !same_vector(o.d, p.d) || o.volume != p.volume ||
+        !same_solids(o.solids_a, p.solids_a) || !same_solids(o.solids_b, p.solids_b))
+      return false;
+    p.frame_a = o.frame_a;
+    p.frame_b = o.frame_b;
+    return true;
+  }
+
+  static bool same_vector(const Vec3& u, const Vec3& v) { return u.x == v.x && u.y == v.y && u.z == v.z; }
+  static bool same_solids(const PairSolids& u, const PairSolids& v) {
+    return u.cubes == v.cubes && same_vector(u.half_i, v.half_i) && same_vector(u.half_j, v.half_j);
+  }
+
+  std::vector<BodyLink> links_, previous_links_;
+  std::vector<CellPair> pairs_, previous_pairs_;
   std::vector<LatticeBody> bodies_;
 };
 
