@@ -87,10 +87,10 @@ def test_field_of_no_points():
 
 
 def test_team20_scene_force_against_measured():
-    """TEAM problem 20 (examples/team20.json, 5 mm cells, default settings) at
+    """TEAM problem 20 (benchmarks/team20.json, 5 mm cells, default settings) at
     5000 ampere-turns: the force on the pole within 8% of the measured 80.1 N
     (the scene gives 84.3 N, +5.2%; docs/validation.md "TEAM 20 as a scene")."""
-    scene = json.loads((ROOT / "examples/team20.json").read_text())
+    scene = json.loads((ROOT / "benchmarks/team20.json").read_text())
     coil_body = next(b for b in scene["bodies"] if b.get("coils"))
     coil_body["coils"][0]["current"] = 5000.0
     sol = odemag.load(scene).solve()

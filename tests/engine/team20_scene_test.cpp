@@ -1,4 +1,4 @@
-// TEAM workshop problem 20 as users run it: examples/team20.json through
+// TEAM workshop problem 20 as users run it: benchmarks/team20.json through
 // solve_scene and scene_field (what `odemag solve`, `odemag field` and
 // Python's Scene.solve / Scene.field compute), against the problem's geometry
 // and the measured force and gap flux density written in
@@ -17,7 +17,7 @@ namespace odemag {
 namespace {
 
 SceneDescription team20_scene(double ampere_turns) {
-  SceneDescription scene = load_scene(ODEMAG_SOURCE_DIR "/examples/team20.json");
+  SceneDescription scene = load_scene(ODEMAG_SOURCE_DIR "/benchmarks/team20.json");
   for (BodyDescription& body : scene.bodies)
     for (CoilSource& coil : body.coils) std::get<RoundedRectangleCoil>(coil).current = ampere_turns;
   return scene;
