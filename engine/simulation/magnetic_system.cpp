@@ -28,14 +28,19 @@ bool takes_contact_zones(const SceneDescription& scene, int b) {
 
 namespace {
 
+// Whether body o's material is magnetized or soft (a body a zone can face).
+bool zone_partner_material(const SceneDescription& scene, size_t o) {
+  const auto material = scene.materials.find(scene.bodies[o].material);
+  return material != scene.materials.end() && !is_inert(material->second);
+}
+
 // Whether another body of the scene could give body b zones: a magnetized or
 // soft body for a ball, another such box for a box (contact_zones).
 bool has_zone_partner(const SceneDescription& scene, int b) {
   const bool box = std::holds_alternative<Box>(scene.bodies[b].shape);
   for (size_t o = 0; o < scene.bodies.size(); ++o) {
     if (static_cast<int>(o) == b) continue;
-    const auto material = scene.materials.find(scene.bodies[o].material);
-    if (material == scene.materials.end() || is_inert(material->second)) continue;
+    if (!zone_partner_material(scene, o)) continue;
     if (!box || std::holds_alternative<Box>(scene.bodies[o].shape)) return true;
   }
   return false;
@@ -92,9 +97,7 @@ std::vector<Vec3> contact_points(const SceneDescription& scene, const std::vecto
   std::vector<Vec3> points;
   for (size_t o = 0; o < scene.bodies.size(); ++o) {
     const BodyDescription& other = scene.bodies[o];
-    const auto other_material = scene.materials.find(other.material);
-    if (static_cast<int>(o) == b || other_material == scene.materials.end() ||
-        is_inert(other_material->second) || (!active.empty() && !active[o]))
+    if (static_cast<int>(o) == b || !zone_partner_material(scene, o) || (!active.empty() && !active[o]))
       continue;
     // The other body's point nearest this ball's centre, and this ball's
     // surface point towards it.
@@ -120,9 +123,7 @@ std::vector<RefinedZone> contact_zones(const SceneDescription& scene,
     if (!takes_contact_zones(scene, b)) return zones;
     for (size_t o = 0; o < scene.bodies.size(); ++o) {
       const auto* other = std::get_if<Box>(&scene.bodies[o].shape);
-      const auto material = scene.materials.find(scene.bodies[o].material);
-      if (static_cast<int>(o) == b || !other || material == scene.materials.end() || is_inert(material->second) ||
-          (!active.empty() && !active[o]))
+      if (static_cast<int>(o) == b || !other || !zone_partner_material(scene, o) || (!active.empty() && !active[o]))
         continue;
       RefinedZone zone;
       if (box_facing_zone(*box, poses[b], *other, poses[o], h, zone)) zones.push_back(zone);
